@@ -1,0 +1,93 @@
+"""The ``nctwin`` command line.
+
+``nctwin estimate PROGRAM [--machine NAME] [--method cam] [--json]`` prints the cycle time of a
+part program; ``nctwin machines`` lists the shipped machine profiles. Bad input ends with exit
+code 2 and one line ``file:line: reason`` on standard error, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+
+from . import __version__
+from .estimate import METHODS, estimate
+from .gcode import GCodeError, parse_file
+from .machine import DEFAULT_MACHINE, available_machines, load_machine
+
+__all__ = ["main"]
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="nctwin", description=__doc__.split("\n\n")[0])
+    p.add_argument("--version", action="version", version=f"nctwin {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    e = sub.add_parser("estimate", help="estimate the cycle time of a part program")
+    e.add_argument("program", help="G-code file")
+    e.add_argument("--machine", default=DEFAULT_MACHINE,
+                   help=f"shipped profile name or .toml path (default: {DEFAULT_MACHINE})")  # fmt: skip
+    e.add_argument("--method", default="cam", choices=sorted(METHODS),
+                   help="estimator (default: cam)")  # fmt: skip
+    e.add_argument("--units", default="mm", choices=("mm", "inch"),
+                   help="units before the program's own G20/G21 (default: mm)")  # fmt: skip
+    e.add_argument("--dwell-p-unit", default="s", choices=("s", "ms"),
+                   help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc)")  # fmt: skip
+    e.add_argument("--json", action="store_true", help="print machine-readable JSON")
+
+    sub.add_parser("machines", help="list the shipped machine profiles")
+    return p
+
+
+def _format_duration(seconds: float) -> str:
+    m, s = divmod(seconds, 60.0)
+    h, m = divmod(int(m), 60)
+    return f"{h}:{m:02d}:{s:04.1f}"
+
+
+def _estimate(args: argparse.Namespace) -> int:
+    machine = load_machine(args.machine)
+    tp = parse_file(args.program, units=args.units, dwell_p_unit=args.dwell_p_unit)
+    result = estimate(tp, machine, args.method)
+    summary = {"program": args.program, **result.summary()}
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return 0
+    print(f"program      {args.program}")
+    print(f"machine      {machine.name}")
+    print(f"method       {result.method}")
+    print(f"cycle time   {summary['cycle_time_s']:.3f} s  ({_format_duration(result.cycle_time_s)})")
+    print(f"path length  {summary['length_mm']:.3f} mm")
+    print(f"blocks       {summary['blocks']}")
+    print(f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}")
+    for kind, row in summary["by_kind"].items():
+        if row["blocks"]:
+            print(f"  {kind:<8} {row['blocks']:>8d} {row['length_mm']:>12.3f} {row['time_s']:>10.3f}")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "machines":
+            for name in available_machines():
+                print(f"{name:<16} {load_machine(name).description}")
+            return 0
+        return _estimate(args)
+    except GCodeError as exc:
+        where = f"{exc.source}:{exc.line}" if exc.line else f"{exc.source}"
+        print(f"{where}: {exc.reason}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # output piped into a pager or head that stopped reading
+        sys.stderr.close()
+        return 0
+    except ValueError as exc:
+        print(f"nctwin: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,28 @@
+"""Cycle-time estimators that do not simulate the motion.
+
+Each method is a function ``f(toolpath, machine) -> Estimate``; :data:`METHODS` maps the names
+the CLI accepts to them. Later chapters add their methods here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ..machine import MachineProfile
+from ..toolpath import Toolpath
+from .cam import cam
+from .result import Estimate
+
+__all__ = ["METHODS", "Estimate", "cam", "estimate"]
+
+#: Estimators by name.
+METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {"cam": cam}
+
+
+def estimate(toolpath: Toolpath, machine: MachineProfile, method: str = "cam") -> Estimate:
+    """Estimate the cycle time of ``toolpath`` on ``machine`` with the named method."""
+    try:
+        fn = METHODS[method]
+    except KeyError:
+        raise ValueError(f"method = {method!r} is unknown: allowed {', '.join(METHODS)}") from None
+    return fn(toolpath, machine)
