@@ -12,9 +12,9 @@ Paper tables
     tells, ``page_or_section``; a free-text ``note`` column records transcription caveats. The
     numbers are exactly as printed. ``data/papers/README.md`` lists the files.
 Data location
-    The data folder is ``<repo>/data`` (the package is installed editable), or the folder named by
-    the environment variable ``NCTWIN_DATA``; paper tables are in its ``papers/`` sub-folder.
-    Results go to ``<repo>/results`` or to ``NCTWIN_RESULTS``. Both are read at call time.
+    :mod:`nctwin.paths`: the data folder is ``<repo>/data`` (the package is installed editable)
+    or ``$NCTWIN_DATA``, with the paper tables in its ``papers/`` sub-folder; results go to
+    ``<repo>/results`` or ``$NCTWIN_RESULTS``. Both are read at call time.
 Errors
     Relative errors are in percent,
 
@@ -49,34 +49,30 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from . import paths
+
 __all__ = [
     "CITING_COLUMNS",
     "FLOAT_FORMAT",
     "META_COLUMNS",
     "OPS",
     "PAPERS_DIR",
-    "REPO_ROOT",
     "Claim",
     "UnknownTableError",
     "accuracy_pct",
     "available_tables",
-    "data_dir",
     "error_pct",
     "format_paper_table",
     "format_table",
     "load_paper_table",
     "paper_tables",
     "papers_dir",
-    "results_root",
     "side_by_side",
     "write_claims",
     "write_table",
 ]
 
-REPO_ROOT: Path = Path(__file__).resolve().parents[2]
-"""Root of the repository (the package is installed editable from ``src/``)."""
-
-PAPERS_DIR: Path = REPO_ROOT / "data" / "papers"
+PAPERS_DIR: Path = paths.repo_root() / "data" / "papers"
 """Default folder of the paper tables; :func:`papers_dir` applies the ``NCTWIN_DATA`` override."""
 
 CITING_COLUMNS: tuple[str, ...] = ("paper", "table", "page_or_section")
@@ -111,21 +107,12 @@ class UnknownTableError(KeyError):
 # Locations
 
 
-def data_dir() -> Path:
-    """Return the data folder: ``$NCTWIN_DATA`` if set, else ``<repo>/data``."""
-    env = os.environ.get("NCTWIN_DATA")
-    return Path(env) if env else REPO_ROOT / "data"
-
-
 def papers_dir() -> Path:
-    """Return the folder of the paper tables, ``data_dir() / "papers"``."""
-    return data_dir() / "papers"
+    """Return the folder of the paper tables, ``paths.data_dir() / "papers"``.
 
-
-def results_root() -> Path:
-    """Return the results folder: ``$NCTWIN_RESULTS`` if set, else ``<repo>/results``."""
-    env = os.environ.get("NCTWIN_RESULTS")
-    return Path(env) if env else REPO_ROOT / "results"
+    ``paths.data_dir()`` is ``<repo>/data``, or ``$NCTWIN_DATA`` if set, read at call time.
+    """
+    return paths.data_dir() / "papers"
 
 
 def _check_simple_name(value: str, what: str) -> str:
@@ -173,11 +160,21 @@ def paper_tables(paper: str, selected: Iterable[str] | None = None) -> list[str]
     Returns
     -------
     list of str
-        Table names in :func:`available_tables` order.
+        The paper's numbered tables first (``table1``, ``table2``, ... in number order), then its
+        other files in alphabetical order, its ``summary`` last.
     """
     if selected is not None and paper not in set(selected):
         return []
-    return [name for name in available_tables() if name.split("_", 1)[0] == paper]
+    names = [name for name in available_tables() if name.split("_", 1)[0] == paper]
+    return sorted(names, key=_table_order)
+
+
+def _table_order(name: str) -> tuple[int, int, str]:
+    """Sort key: ``<paper>_table<N>`` by N, then other names, then ``<paper>_summary``."""
+    match = re.fullmatch(r"[^_]+_table(\d+)", name)
+    if match:
+        return (0, int(match.group(1)), name)
+    return (2 if name.endswith("_summary") else 1, 0, name)
 
 
 def load_paper_table(name: str, *, directory: Path | None = None) -> pd.DataFrame:
@@ -486,7 +483,7 @@ def write_table(stem: str, name: str, df: pd.DataFrame, *, results_dir: Path | N
     df
         Table to write; the index is not written.
     results_dir
-        Results folder; default :func:`results_root` (``<repo>/results`` or ``$NCTWIN_RESULTS``).
+        Results folder; default ``paths.results_dir()`` (``<repo>/results`` or ``$NCTWIN_RESULTS``).
 
     Returns
     -------
@@ -508,7 +505,7 @@ def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None
     claims
         Claims in the order they should appear; their ids must be unique.
     results_dir
-        Results folder; default :func:`results_root`.
+        Results folder; default ``paths.results_dir()``.
 
     Returns
     -------
@@ -530,7 +527,7 @@ def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None
 
 
 def _results_folder(stem: str, folder: Path | None) -> Path:
-    base = results_root() if folder is None else Path(folder)
+    base = paths.results_dir() if folder is None else Path(folder)
     return base / _check_simple_name(stem, "stem")
 
 
