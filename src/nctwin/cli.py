@@ -27,14 +27,26 @@ def _parser() -> argparse.ArgumentParser:
 
     e = sub.add_parser("estimate", help="estimate the cycle time of a part program")
     e.add_argument("program", help="G-code file")
-    e.add_argument("--machine", default=DEFAULT_MACHINE,
-                   help=f"shipped profile name or .toml path (default: {DEFAULT_MACHINE})")  # fmt: skip
-    e.add_argument("--method", default="cam", choices=sorted(METHODS),
-                   help="estimator (default: cam)")  # fmt: skip
-    e.add_argument("--units", default="mm", choices=("mm", "inch"),
-                   help="units before the program's own G20/G21 (default: mm)")  # fmt: skip
-    e.add_argument("--dwell-p-unit", default="s", choices=("s", "ms"),
-                   help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc)")  # fmt: skip
+    e.add_argument(
+        "--machine",
+        default=DEFAULT_MACHINE,
+        help=f"shipped profile name or .toml path (default: {DEFAULT_MACHINE})",
+    )
+    e.add_argument(
+        "--method", default="cam", choices=sorted(METHODS), help="estimator (default: cam)"
+    )
+    e.add_argument(
+        "--units",
+        default="mm",
+        choices=("mm", "inch"),
+        help="units before the program's own G20/G21 (default: mm)",
+    )
+    e.add_argument(
+        "--dwell-p-unit",
+        default="s",
+        choices=("s", "ms"),
+        help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc)",
+    )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
     sub.add_parser("machines", help="list the shipped machine profiles")
@@ -58,13 +70,17 @@ def _estimate(args: argparse.Namespace) -> int:
     print(f"program      {args.program}")
     print(f"machine      {machine.name}")
     print(f"method       {result.method}")
-    print(f"cycle time   {summary['cycle_time_s']:.3f} s  ({_format_duration(result.cycle_time_s)})")
+    print(
+        f"cycle time   {summary['cycle_time_s']:.3f} s  ({_format_duration(result.cycle_time_s)})"
+    )
     print(f"path length  {summary['length_mm']:.3f} mm")
     print(f"blocks       {summary['blocks']}")
     print(f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}")
     for kind, row in summary["by_kind"].items():
         if row["blocks"]:
-            print(f"  {kind:<8} {row['blocks']:>8d} {row['length_mm']:>12.3f} {row['time_s']:>10.3f}")
+            print(
+                f"  {kind:<8} {row['blocks']:>8d} {row['length_mm']:>12.3f} {row['time_s']:>10.3f}"
+            )
     return 0
 
 

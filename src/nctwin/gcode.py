@@ -89,24 +89,52 @@ _CHAR_REASON = {
 _MOTION, _NONMODAL, _PLANE, _UNITS, _DIST, _ARCDIST, _FEEDMODE = range(7)
 _CUTTER, _TLO, _COORD, _PATH = range(7, 11)
 _GROUP_NAMES = (
-    "motion", "non-modal", "plane", "units", "distance mode", "arc distance mode",
-    "feed mode", "cutter compensation", "tool length offset", "coordinate system",
+    "motion",
+    "non-modal",
+    "plane",
+    "units",
+    "distance mode",
+    "arc distance mode",
+    "feed mode",
+    "cutter compensation",
+    "tool length offset",
+    "coordinate system",
     "path control",
-)  # fmt: skip
+)
 _G_GROUP = {
-    0: _MOTION, 10: _MOTION, 20: _MOTION, 30: _MOTION, 800: _MOTION,
-    40: _NONMODAL, 530: _NONMODAL,
-    170: _PLANE, 180: _PLANE, 190: _PLANE,
-    200: _UNITS, 210: _UNITS,
-    900: _DIST, 910: _DIST,
-    901: _ARCDIST, 911: _ARCDIST,
+    0: _MOTION,
+    10: _MOTION,
+    20: _MOTION,
+    30: _MOTION,
+    800: _MOTION,
+    40: _NONMODAL,
+    530: _NONMODAL,
+    170: _PLANE,
+    180: _PLANE,
+    190: _PLANE,
+    200: _UNITS,
+    210: _UNITS,
+    900: _DIST,
+    910: _DIST,
+    901: _ARCDIST,
+    911: _ARCDIST,
     940: _FEEDMODE,
     400: _CUTTER,
-    430: _TLO, 490: _TLO,
-    540: _COORD, 550: _COORD, 560: _COORD, 570: _COORD, 580: _COORD, 590: _COORD,
-    591: _COORD, 592: _COORD, 593: _COORD,
-    610: _PATH, 611: _PATH, 640: _PATH,
-}  # fmt: skip
+    430: _TLO,
+    490: _TLO,
+    540: _COORD,
+    550: _COORD,
+    560: _COORD,
+    570: _COORD,
+    580: _COORD,
+    590: _COORD,
+    591: _COORD,
+    592: _COORD,
+    593: _COORD,
+    610: _PATH,
+    611: _PATH,
+    640: _PATH,
+}
 _G_CODES = np.array(sorted(_G_GROUP), dtype=np.int64)
 _G_GROUPS = np.array([_G_GROUP[c] for c in _G_CODES], dtype=np.int64)
 _G_UNSUPPORTED = {
@@ -133,8 +161,12 @@ _G_UNSUPPORTED = {
     432: "additional tool length offset (G43.2)",
     520: "local coordinate system (G52)",
 }
-_KIND_OF_MOTION = {0: MotionKind.RAPID, 10: MotionKind.LINEAR, 20: MotionKind.ARC_CW,
-                   30: MotionKind.ARC_CCW}  # fmt: skip
+_KIND_OF_MOTION = {
+    0: MotionKind.RAPID,
+    10: MotionKind.LINEAR,
+    20: MotionKind.ARC_CW,
+    30: MotionKind.ARC_CCW,
+}
 _SINGLE = "FHIJKNPQRSTXYZ"  # letters allowed once per line
 _ROW = np.full(26, -1, dtype=np.int64)  # letter code -> row of the per-line word table
 _ROW[[_L[c] for c in _SINGLE]] = np.arange(len(_SINGLE))
@@ -177,7 +209,9 @@ class _Errors:
         hits = np.flatnonzero(mask)
         if len(hits):
             i = int(hits[0])
-            self.found.append((int(self.line_starts[i]), i, reason(i) if callable(reason) else reason))
+            self.found.append(
+                (int(self.line_starts[i]), i, reason(i) if callable(reason) else reason)
+            )
 
     def first_line(self) -> int:
         return min(f[1] for f in self.found) if self.found else len(self.line_starts)
@@ -260,8 +294,9 @@ def _lex(b: np.ndarray, errors: _Errors) -> dict[str, np.ndarray]:
     dig_pos = np.flatnonzero(is_digit)
     dig_tok = tok[dig_pos]
     exp = before[1:][dig_tok] - digcum[dig_pos]  # digits after each digit in its word
-    mant = np.bincount(dig_tok, weights=_DIGIT_WEIGHT[b[dig_pos], np.minimum(exp, 22)],
-                       minlength=len(anchors))  # fmt: skip
+    mant = np.bincount(
+        dig_tok, weights=_DIGIT_WEIGHT[b[dig_pos], np.minimum(exp, 22)], minlength=len(anchors)
+    )
     dot_pos = np.flatnonzero(is_dot)
     frac = np.zeros(len(anchors), dtype=np.int64)
     frac[tok[dot_pos]] = before[1:][tok[dot_pos]] - digcum[dot_pos]
@@ -366,8 +401,17 @@ def parse(
     n_lines = min(errors.first_line(), end_line)
     keep = words["line"] < n_lines
     code, value, line = words["code"][keep], words["value"][keep], words["line"][keep]
-    tp = _interpret(code, value, line, n_lines, errors, units=units, dwell_p_unit=dwell_p_unit,
-                    start=start, arc_tol=(arc_tol_mm, arc_tol_rel))  # fmt: skip
+    tp = _interpret(
+        code,
+        value,
+        line,
+        n_lines,
+        errors,
+        units=units,
+        dwell_p_unit=dwell_p_unit,
+        start=start,
+        arc_tol=(arc_tol_mm, arc_tol_rel),
+    )
     errors.raise_first()
     return tp
 
@@ -396,13 +440,17 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     for i in np.flatnonzero(~known)[:1]:
         what = _G_UNSUPPORTED.get(int(gcode[i]))
         name = f"G{gval[i]:g}"
-        errors.at_lines(np.arange(n) == gline[i],
-                        f"{name} ({what}) is not supported" if what else f"{name} is not supported")  # fmt: skip
+        errors.at_lines(
+            np.arange(n) == gline[i],
+            f"{name} ({what}) is not supported" if what else f"{name} is not supported",
+        )
     gcode, gline, grp = gcode[known], gline[known], _G_GROUPS[idx[known]]
     n_groups = len(_GROUP_NAMES)
     gdup = np.bincount(gline * n_groups + grp, minlength=n * n_groups).reshape(n, n_groups) > 1
-    errors.at_lines(gdup.any(1), lambda i: "two G-codes of the "
-                    f"{_GROUP_NAMES[np.argmax(gdup[i])]} group in one line")  # fmt: skip
+    errors.at_lines(
+        gdup.any(1),
+        lambda i: f"two G-codes of the {_GROUP_NAMES[np.argmax(gdup[i])]} group in one line",
+    )
     G = np.full((n_groups, n), -1, dtype=np.int64)
     G[grp, gline] = gcode
 
@@ -425,8 +473,11 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     errors.at_lines(has["Q"] & ~g64, "Q word without G64")
     errors.at_lines(has["H"] & (G[_TLO] != 430), "H word without G43")
     errors.at_lines(g64 & ((W["P"] < 0) | (W["Q"] < 0)), "G64 P and Q must be >= 0")
-    mode = np.select([path_code == 640, path_code == 610, path_code == 611],
-                     [PathMode.BLEND, PathMode.EXACT_PATH, PathMode.EXACT_STOP], PathMode.DEFAULT)  # fmt: skip
+    mode = np.select(
+        [path_code == 640, path_code == 610, path_code == 611],
+        [PathMode.BLEND, PathMode.EXACT_PATH, PathMode.EXACT_STOP],
+        PathMode.DEFAULT,
+    )
     blend_p = _ffill(g64, W["P"] * scale, np.nan)
     blend_q = _ffill(g64, W["Q"] * scale, np.nan)
     blend_p[mode != PathMode.BLEND] = np.nan
@@ -438,8 +489,9 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     errors.at_lines(dwell_line & ~has["P"] & ~has["X"], "G4 without a dwell time (P)")
     errors.at_lines(dwell_line & has["P"] & has["X"], "G4 with both P and X")
     errors.at_lines(dwell_line & (dwell_t < 0), "dwell time must be >= 0")
-    errors.at_lines(dwell_line & (has["Y"] | has["Z"] | (G[_MOTION] >= 0)),
-                    "G4 cannot share a line with motion")  # fmt: skip
+    errors.at_lines(
+        dwell_line & (has["Y"] | has["Z"] | (G[_MOTION] >= 0)), "G4 cannot share a line with motion"
+    )
 
     # ---- positions: absolute words set, incremental words add
     axis_given = np.stack([has["X"] & ~dwell_line, has["Y"], has["Z"]], axis=1)  # (n, 3)
@@ -452,12 +504,15 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     prev = np.vstack([start, pos[:-1]]) if n else pos
 
     moves = axis_given.any(1)
-    errors.at_lines(moves & ((motion < 0) | (motion == 800)),
-                    "axis words without an active motion mode (G0/G1/G2/G3)")  # fmt: skip
+    errors.at_lines(
+        moves & ((motion < 0) | (motion == 800)),
+        "axis words without an active motion mode (G0/G1/G2/G3)",
+    )
     arc_line = moves & ((motion == 20) | (motion == 30))
     feed_line = moves & ((motion == 10) | arc_line)
-    errors.at_lines(feed_line & np.isnan(feed),
-                    lambda i: f"{_fmt_g(int(motion[i]))} with no feed rate set (F)")  # fmt: skip
+    errors.at_lines(
+        feed_line & np.isnan(feed), lambda i: f"{_fmt_g(int(motion[i]))} with no feed rate set (F)"
+    )
     ijk = has["I"] | has["J"] | has["K"]
     errors.at_lines((ijk | has["R"]) & ~arc_line, "I/J/K/R words without an arc (G2/G3) move")
 
@@ -465,8 +520,9 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     center = np.full((n, 3), np.nan)
     ai = np.flatnonzero(arc_line)
     if len(ai):
-        center[ai] = _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute,
-                                  errors, arc_tol)  # fmt: skip
+        center[ai] = _arc_centers(
+            ai, prev, pos, plane, motion, W, has, scale, arc_absolute, errors, arc_tol
+        )
 
     # ---- blocks: one per motion or dwell line
     bl = np.flatnonzero(moves | dwell_line)
@@ -482,10 +538,19 @@ def _interpret(code, value, line, n, errors: _Errors, *, units, dwell_p_unit, st
     events["value"] = value[ev]
     end = pos[bl]  # a dwell line has no axis words: its position is the previous one
     return Toolpath(
-        start_mm=prev[bl], end_mm=end, kind=kind[bl], feed_mm_s=feed[bl], center_mm=center[bl],
-        plane=plane[bl], dwell_s=np.where(dwell_line[bl], dwell_t[bl], 0.0), line=bl + 1,
-        path_mode=mode[bl], blend_tol_mm=blend_p[bl], naive_tol_mm=blend_q[bl], events=events,
-    )  # fmt: skip
+        start_mm=prev[bl],
+        end_mm=end,
+        kind=kind[bl],
+        feed_mm_s=feed[bl],
+        center_mm=center[bl],
+        plane=plane[bl],
+        dwell_s=np.where(dwell_line[bl], dwell_t[bl], 0.0),
+        line=bl + 1,
+        path_mode=mode[bl],
+        blend_tol_mm=blend_p[bl],
+        naive_tol_mm=blend_q[bl],
+        events=events,
+    )
 
 
 def _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute, errors, arc_tol):
@@ -511,8 +576,13 @@ def _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute, erro
     flag(use_r & ijk_has.any(1), "arc given with both R and I/J/K")
     flag(~use_r & ~ijk_has.any(1), "arc needs a centre (I/J/K) or a radius (R)")
     wrong = ijk_has[rows, ax[:, 2]] & ~use_r
-    flag(wrong, lambda i: f"{'IJK'[PLANE_AXES[plane[i], 2]]} is not an arc-centre word in the "
-         f"G{17 + plane[i]} plane")  # fmt: skip
+    flag(
+        wrong,
+        lambda i: (
+            f"{'IJK'[PLANE_AXES[plane[i], 2]]} is not an arc-centre word in the "
+            f"G{17 + plane[i]} plane"
+        ),
+    )
 
     # centre from I/J/K
     ca = np.where(arc_absolute[ai], 0.0, sa) + ijk[rows, ax[:, 0]]
@@ -523,8 +593,10 @@ def _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute, erro
     flag(use_r & (chord == 0), "a full circle cannot be given with R")
     with np.errstate(invalid="ignore", divide="ignore"):
         half = 0.5 * chord
-        flag(use_r & (np.abs(r_word) < half - arc_tol[0]),
-             "arc radius R is smaller than half the distance from start to end")  # fmt: skip
+        flag(
+            use_r & (np.abs(r_word) < half - arc_tol[0]),
+            "arc radius R is smaller than half the distance from start to end",
+        )
         h = np.sqrt(np.maximum(r_word**2 - half**2, 0.0))
         side = np.where(ccw, 1.0, -1.0) * np.sign(r_word)
         ra = np.where(use_r, 0.5 * (sa + ea) - side * h * db / chord, ca)
@@ -533,8 +605,12 @@ def _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute, erro
     r_end = np.hypot(ea - ra, eb - rb)
     flag(r_start == 0, "arc radius is zero")
     bad = ~use_r & (np.abs(r_start - r_end) > np.maximum(arc_tol[0], arc_tol[1] * r_start))
-    flag(bad, lambda i: "arc radius differs between start ({:.4f} mm) and end ({:.4f} mm)".format(
-        *(r[np.searchsorted(ai, i)] for r in (r_start, r_end))))  # fmt: skip
+    flag(
+        bad,
+        lambda i: "arc radius differs between start ({:.4f} mm) and end ({:.4f} mm)".format(
+            *(r[np.searchsorted(ai, i)] for r in (r_start, r_end))
+        ),
+    )
     c = np.empty((len(ai), 3))
     c[rows, ax[:, 0]] = ra
     c[rows, ax[:, 1]] = rb
@@ -590,9 +666,14 @@ def dump(tp: Toolpath, *, title: str | None = None) -> str:
         mode = (int(tp.path_mode[k]), tp.blend_tol_mm[k], tp.naive_tol_mm[k])
         if not (mode[0] == path[0] and np.array_equal(mode[1:], path[1:], equal_nan=True)):
             if mode[0] == PathMode.BLEND:
-                out.append("G64" + "".join(f" {w}{_num(v)}" for w, v in zip("PQ", mode[1:],
-                                                                               strict=True)
-                                           if not np.isnan(v)))  # fmt: skip
+                out.append(
+                    "G64"
+                    + "".join(
+                        f" {w}{_num(v)}"
+                        for w, v in zip("PQ", mode[1:], strict=True)
+                        if not np.isnan(v)
+                    )
+                )
             elif mode[0] != PathMode.DEFAULT:
                 out.append("G61" if mode[0] == PathMode.EXACT_PATH else "G61.1")
             else:
@@ -600,8 +681,12 @@ def dump(tp: Toolpath, *, title: str | None = None) -> str:
             path = mode
         kind = tp.kind[k]
         words = []
+        f = tp.feed_mm_s[k]
+        if not np.isnan(f) and f != feed:
+            words.append(f"F{_num(f * 60.0)}")
+            feed = f
         if kind == MotionKind.DWELL:
-            out.append(f"G4 P{_num(tp.dwell_s[k])}")
+            out += [*words, f"G4 P{_num(tp.dwell_s[k])}"]
             continue
         if tp.is_arc[k] and tp.plane[k] != plane:
             plane = int(tp.plane[k])
@@ -611,12 +696,6 @@ def dump(tp: Toolpath, *, title: str | None = None) -> str:
         if tp.is_arc[k]:
             ax = PLANE_AXES[plane]
             words += [f"{'IJK'[a]}{_num(tp.center_mm[k, a])}" for a in ax[:2]]
-        f = tp.feed_mm_s[k]
-        if not np.isnan(f) and f != feed:
-            words.append(f"F{_num(f * 60.0)}")
-            feed = f
         out.append(" ".join(words))
-    out += [f"{w}{_num(v)}" for w, v in zip(events["word"][ei:], events["value"][ei:],
-                                            strict=True)]  # fmt: skip
+    out += [f"{w}{_num(v)}" for w, v in zip(events["word"][ei:], events["value"][ei:], strict=True)]
     return "\n".join(out) + "\n"
-

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .paths import data_dir
 
-__all__ = ["MachineProfile", "available_machines", "load_machine", "DEFAULT_MACHINE"]
+__all__ = ["DEFAULT_MACHINE", "MachineProfile", "available_machines", "load_machine"]
 
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
@@ -110,8 +110,9 @@ class MachineProfile:
         allowed = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - allowed)
         if unknown:
-            raise ValueError(f"{p}: unknown field(s) {', '.join(unknown)}; "
-                             f"allowed: {', '.join(sorted(allowed))}")  # fmt: skip
+            raise ValueError(
+                f"{p}: unknown field(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}"
+            )
         data.setdefault("name", p.stem)
         try:
             return cls(**data)
@@ -121,12 +122,22 @@ class MachineProfile:
             raise ValueError(f"{p}: {exc}") from None
 
 
-def _check(name: str, value, lo: float, hi: float, *, lo_closed: bool = False,
-           hi_closed: bool = False, allow_inf: bool = False) -> None:  # fmt: skip
+def _check(
+    name: str,
+    value,
+    lo: float,
+    hi: float,
+    *,
+    lo_closed: bool = False,
+    hi_closed: bool = False,
+    allow_inf: bool = False,
+) -> None:
     """Raise ValueError unless ``value`` is a number in the given interval."""
     ok = isinstance(value, int | float) and not isinstance(value, bool) and not math.isnan(value)
     if ok and not (allow_inf and value == math.inf):
-        ok = (lo <= value if lo_closed else lo < value) and (value <= hi if hi_closed else value < hi)
+        ok = (lo <= value if lo_closed else lo < value) and (
+            value <= hi if hi_closed else value < hi
+        )
     if not ok:
         interval = f"{'[' if lo_closed else '('}{lo:g}, {hi:g}{']' if hi_closed else ')'}"
         extra = " or inf" if allow_inf else ""
@@ -158,6 +169,8 @@ def load_machine(name: str | Path | None = None) -> MachineProfile:
         return MachineProfile.from_toml(p)
     shipped = machines_dir() / f"{name}.toml"
     if not shipped.exists():
-        raise ValueError(f"machine = {str(name)!r} is unknown: allowed "
-                         f"{', '.join(available_machines())} or a path to a .toml file")  # fmt: skip
+        raise ValueError(
+            f"machine = {str(name)!r} is unknown: allowed "
+            f"{', '.join(available_machines())} or a path to a .toml file"
+        )
     return MachineProfile.from_toml(shipped)

@@ -177,7 +177,10 @@ class Toolpath:
         """Signed swept angle of arcs (positive counter-clockwise), shape (N,); 0 for others."""
         with np.errstate(invalid="ignore"):
             sweep = arc_sweep(
-                self.start_mm, self.end_mm, self.center_mm, self.plane,
+                self.start_mm,
+                self.end_mm,
+                self.center_mm,
+                self.plane,
                 self.kind == MotionKind.ARC_CCW,
             )
         return np.where(self.is_arc, sweep, 0.0)
@@ -201,7 +204,7 @@ class Toolpath:
 
     @cached_property
     def directions(self) -> np.ndarray:
-        """Unit chord direction (end − start) of each block, shape (N, 3); zeros where the chord
+        """Unit chord direction (end - start) of each block, shape (N, 3); zeros where the chord
         is zero (dwells, full circles, zero-length moves)."""
         d = self.end_mm - self.start_mm
         n = np.linalg.norm(d, axis=1, keepdims=True)
