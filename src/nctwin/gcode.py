@@ -170,9 +170,7 @@ _KIND_OF_MOTION = {
 _SINGLE = "FHIJKNPQRSTXYZ"  # letters allowed once per line
 _ROW = np.full(26, -1, dtype=np.int64)  # letter code -> row of the per-line word table
 _ROW[[_L[c] for c in _SINGLE]] = np.arange(len(_SINGLE))
-_POW10 = 10.0 ** np.arange(23)
-_DIGIT_WEIGHT = np.zeros((256, 23))  # [byte, exponent] -> digit * 10**exponent
-_DIGIT_WEIGHT[48:58] = np.arange(10)[:, None] * _POW10
+
 
 _PAREN = re.compile(r"\([^()\n]*\)")
 _SEMI = re.compile(r";[^\n]*")
@@ -190,6 +188,8 @@ _CLASS[65:91] = _LETTER
 _CLASS[48:58] = _DIGIT
 _CLASS[46] = _DOT
 _CLASS[[43, 45]] = _SIGN
+_SPACE = np.arange(256, dtype=np.uint8)  # letters and newlines become blanks between numbers
+_SPACE[(_CLASS == _LETTER) | (_CLASS == _NL)] = 32
 
 
 class _Errors:
@@ -212,6 +212,10 @@ class _Errors:
             self.found.append(
                 (int(self.line_starts[i]), i, reason(i) if callable(reason) else reason)
             )
+
+    def first_pos(self) -> int:
+        """Position of the earliest error, or the end of the text."""
+        return min(f[0] for f in self.found) if self.found else 1 << 62
 
     def first_line(self) -> int:
         return min(f[1] for f in self.found) if self.found else len(self.line_starts)
@@ -253,7 +257,6 @@ def _lex(b: np.ndarray, errors: _Errors) -> dict[str, np.ndarray]:
     cls = _CLASS[b]
     is_nl = cls == _NL
     is_letter = cls == _LETTER
-    is_digit = cls == _DIGIT
     is_dot = cls == _DOT
     is_sign = cls == _SIGN
     is_num = cls >= _DIGIT
@@ -270,52 +273,41 @@ def _lex(b: np.ndarray, errors: _Errors) -> dict[str, np.ndarray]:
         c = chr(b[pos])
         errors.at_pos(int(pos), _LETTER_REASON.get(c, f"{c} words are not supported"))
 
-    # each character belongs to the word opened by the last letter, or to no word after a
-    # newline; anchor 0 is a virtual newline before the text, the last one its end
-    opens = is_letter | is_nl
-    anchors = np.concatenate([[-1], np.flatnonzero(opens), [len(b)]])
-    tok = np.cumsum(opens, dtype=np.int32)  # index into anchors
-    orphan = is_num & np.concatenate([[True], is_nl[:-1]])
-    for pos in np.flatnonzero(orphan)[:1]:
+    # a number must follow a letter: [+-]?(digits[.digits] | .digits), nothing else
+    prev_nl = np.concatenate([[True], is_nl[:-1]])
+    for pos in np.flatnonzero(is_num & prev_nl)[:1]:
         errors.at_pos(int(pos), "number without a word letter")
-
-    digcum = np.cumsum(is_digit, dtype=np.int32)  # digits up to and including each position
-    before = np.concatenate([[0], digcum])[np.minimum(anchors + 1, len(b))]  # digits before
-    ndig = np.diff(before)  # digits of each word
-    ndot = np.bincount(tok[is_dot], minlength=len(anchors))
+    ext = np.append(cls, _NL)  # class of each byte, and a newline past the end
+    p = letters + 1
+    p += ext[p] == _SIGN
+    p += ext[p] == _DOT
+    malformed = ext[p] != _DIGIT
     sign_pos = np.flatnonzero(is_sign)
-    bad_sign = sign_pos != anchors[tok[sign_pos]] + 1
-    word_idx = tok[letters]  # anchor index of each letter
-    malformed = (ndig[word_idx] == 0) | (ndot[word_idx] > 1)
-    for pos in np.sort(np.concatenate([letters[malformed], sign_pos[bad_sign]]))[:1]:
-        errors.at_pos(int(pos), f"malformed number after word {chr(b[anchors[tok[pos]]])}")
-
-    # value = mantissa / 10**fraction_digits, exact (correctly rounded) for <= 15 digits
-    dig_pos = np.flatnonzero(is_digit)
-    dig_tok = tok[dig_pos]
-    exp = before[1:][dig_tok] - digcum[dig_pos]  # digits after each digit in its word
-    mant = np.bincount(
-        dig_tok, weights=_DIGIT_WEIGHT[b[dig_pos], np.minimum(exp, 22)], minlength=len(anchors)
-    )
     dot_pos = np.flatnonzero(is_dot)
-    frac = np.zeros(len(anchors), dtype=np.int64)
-    frac[tok[dot_pos]] = before[1:][tok[dot_pos]] - digcum[dot_pos]
-    neg = np.zeros(len(anchors), dtype=bool)
-    neg[tok[sign_pos]] = b[sign_pos] == 45
-    mant_w, frac_w, ndig_w = mant[word_idx], frac[word_idx], ndig[word_idx]
-    value = mant_w / _POW10[np.minimum(frac_w, 22)]
-    slow = np.flatnonzero((ndig_w > 15) | (frac_w > 22))
-    ends = anchors[word_idx + 1]
-    for i in slow:  # long numbers: let Python round them
-        digits = b[letters[i] + 1 : ends[i]].tobytes().lstrip(b"+-")
-        value[i] = float(digits) if not malformed[i] else np.nan
-    value = np.where(neg[word_idx], -value, value)
-    big = ~np.isfinite(value) & ~malformed
+    dot_word = np.searchsorted(letters, dot_pos)  # the word (letter index + 1) of each dot
+    stray = np.concatenate([
+        sign_pos[~np.concatenate([[False], is_letter[:-1]])[sign_pos]],  # sign not after a letter
+        dot_pos[1:][dot_word[1:] == dot_word[:-1]],  # second dot in a word
+    ])
+    stray_word = np.searchsorted(letters, stray) - 1
+    stray = stray[stray_word >= 0]  # (one before any letter is a number without a letter)
+    malformed[stray_word[stray_word >= 0]] = True
+    # (a word cut short by a character that is itself an error is reported by that error)
+    telling = malformed & (ext[p] != _OTHER)
+    for pos in np.sort(np.concatenate([letters[telling], stray]))[:1]:
+        word = letters[np.searchsorted(letters, pos, side="right") - 1]
+        errors.at_pos(int(pos), f"malformed number after word {chr(b[word])}")
+
+    # numbers are read by C (strtod: correctly rounded, as Python's float) up to the first error
+    cut = min(errors.first_pos(), int(letters[malformed][0]) if malformed.any() else 1 << 62)
+    n_ok = int(np.searchsorted(letters, cut))
+    value = np.full(len(letters), np.nan)
+    value[:n_ok] = np.fromstring(_SPACE[b[:cut]].tobytes(), sep=" ")
+    big = np.isinf(value)
     for pos in letters[big][:1]:
         errors.at_pos(int(pos), "number out of range")
-    newline = np.concatenate([[False], b[anchors[1:-1]] == 10])
-    line = np.cumsum(newline)[word_idx]  # newlines before each letter
-    keep = ~(bad_letter | malformed | big)
+    line = np.cumsum(is_nl)[letters]  # newlines before each letter
+    keep = ~(bad_letter | malformed | big) & (np.arange(len(letters)) < n_ok)
     return {"code": codes[keep].astype(np.int64), "value": value[keep], "line": line[keep]}
 
 

@@ -1,0 +1,73 @@
+"""The command line: output, JSON, exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from nctwin.cli import main
+
+PROGRAM = "G21 G90\nG0 Z5\nG1 Z0 F600\nX30\nM30\n"
+
+
+@pytest.fixture
+def program(tmp_path):
+    p = tmp_path / "part.nc"
+    p.write_text(PROGRAM)
+    return p
+
+
+def test_estimate_prints_time_length_blocks_and_kinds(program, capsys):
+    assert main(["estimate", str(program)]) == 0
+    out = capsys.readouterr().out
+    assert "cycle time" in out and "path length  40.000 mm" in out and "blocks       3" in out
+    assert "linear" in out and "rapid" in out
+
+
+def test_estimate_json(program, capsys):
+    assert main(["estimate", str(program), "--json", "--machine", "linuxcnc_sim"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["method"] == "cam" and data["machine"] == "linuxcnc_sim"
+    assert data["blocks"] == 3
+    assert data["length_mm"] == pytest.approx(40.0)
+    # 5 mm rapid at 200 mm/s + 35 mm at 10 mm/s
+    assert data["cycle_time_s"] == pytest.approx(5 / 200 + 3.5)
+
+
+def test_bad_program_gives_file_line_reason_and_exit_2(tmp_path, capsys):
+    bad = tmp_path / "bad.nc"
+    bad.write_text("G0 X0\nG1 X1\n")
+    assert main(["estimate", str(bad)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"{bad}:2: G1 with no feed rate set (F)"]
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["estimate", "/no/such/file.nc"], "/no/such/file.nc: cannot read the file"),
+        (["estimate", "{prog}", "--machine", "nope"], "machine = 'nope' is unknown"),
+    ],
+)
+def test_bad_arguments_exit_2_without_traceback(program, capsys, args, needle):
+    args = [a.replace("{prog}", str(program)) for a in args]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert needle in err and "Traceback" not in err
+
+
+def test_installed_entry_point_runs(program):
+    proc = subprocess.run(
+        [sys.executable, "-m", "nctwin.cli", "estimate", str(program), "--json"],
+        capture_output=True, text=True, check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["blocks"] == 3
+
+
+def test_machines_lists_profiles(capsys):
+    assert main(["machines"]) == 0
+    assert "generic_mill" in capsys.readouterr().out
