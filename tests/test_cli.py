@@ -62,7 +62,9 @@ def test_bad_arguments_exit_2_without_traceback(program, capsys, args, needle):
 def test_installed_entry_point_runs(program):
     proc = subprocess.run(
         [sys.executable, "-m", "nctwin.cli", "estimate", str(program), "--json"],
-        capture_output=True, text=True, check=False,
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout)["blocks"] == 3

@@ -72,7 +72,7 @@ def test_jerk_may_be_unlimited():
 def test_toml_errors(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text('description = "x"\nrapid_feed_mm_s = 100\nwarp_factor = 9\n')
-    with pytest.raises(ValueError, match="unknown field.*warp_factor"):
+    with pytest.raises(ValueError, match=r"unknown field.*warp_factor"):
         load_machine(bad)
     missing = tmp_path / "missing.toml"
     missing.write_text('description = "x"\n')

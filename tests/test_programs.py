@@ -5,14 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import SHARED_PROGRAMS
 
 from nctwin import GCodeError, dump, parse, parse_file
 from nctwin.estimate import estimate
 from nctwin.machine import load_machine
 
-from conftest import SHARED_PROGRAMS
-
-PROGRAMS = sorted(p.name for p in SHARED_PROGRAMS.glob("*") if p.suffix in (".ngc", ".nc", ".gcode"))
+SUFFIXES = (".ngc", ".nc", ".gcode")
+PROGRAMS = sorted(p.name for p in SHARED_PROGRAMS.glob("*") if p.suffix in SUFFIXES)
 #: The programs nctwin rejects, and the construct it must name.
 REJECTED = {"3D_Chips.ngc": (9, "#parameters are not supported")}
 

@@ -285,10 +285,14 @@ def _lex(b: np.ndarray, errors: _Errors) -> dict[str, np.ndarray]:
     sign_pos = np.flatnonzero(is_sign)
     dot_pos = np.flatnonzero(is_dot)
     dot_word = np.searchsorted(letters, dot_pos)  # the word (letter index + 1) of each dot
-    stray = np.concatenate([
-        sign_pos[~np.concatenate([[False], is_letter[:-1]])[sign_pos]],  # sign not after a letter
-        dot_pos[1:][dot_word[1:] == dot_word[:-1]],  # second dot in a word
-    ])
+    stray = np.concatenate(
+        [
+            sign_pos[
+                ~np.concatenate([[False], is_letter[:-1]])[sign_pos]
+            ],  # sign not after a letter
+            dot_pos[1:][dot_word[1:] == dot_word[:-1]],  # second dot in a word
+        ]
+    )
     stray_word = np.searchsorted(letters, stray) - 1
     stray = stray[stray_word >= 0]  # (one before any letter is a number without a letter)
     malformed[stray_word[stray_word >= 0]] = True
