@@ -1,0 +1,170 @@
+# nctwin — reproducibility package for five NC-machining papers.
+#
+#   make reproduce   set up .venv, execute every notebook, build the book (HTML)
+#   make test        what CI runs (.ci/run): lint, unit tests, nbval, book build, browser check
+#
+# Everything runs through .venv/bin/... explicitly; nothing needs `source activate`.
+# Only PyPI (pip), Debian (apt) and npm are used; nothing is downloaded while notebooks run.
+
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DEFAULT_GOAL := help
+.NOTPARALLEL:
+.SUFFIXES:
+
+PYTHON_BOOTSTRAP ?= python3.11
+VENV            := .venv
+PY              := $(VENV)/bin/python
+VENV_STAMP      := $(VENV)/.nctwin-requirements.sha256
+MATHJAX_VERSION := 3.2.2
+MATHJAX_DIR     := book/_vendor/mathjax
+NPM_CACHE       := build/npm
+CHROMIUM        ?= /usr/bin/chromium
+HTML_DIR        := book/_build/html
+
+# Source notebooks and the executed copies the book renders (committed).
+NOTEBOOKS := $(sort $(wildcard notebooks/*.ipynb))
+EXECUTED  := $(patsubst notebooks/%,book/notebooks/%,$(NOTEBOOKS))
+
+# Same inputs, same outputs: fixed hashing, no GUI backend, fixed time zone, and the venv's own
+# Jupyter kernel (the kernelspec installed with --sys-prefix wins over any user-level one).
+export PYTHONHASHSEED := 0
+export MPLBACKEND := Agg
+export TZ := UTC
+export JUPYTER_PREFER_ENV_PATH := 1
+export PYDEVD_DISABLE_FILE_VALIDATION := 1
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
+
+.PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
+        clean distclean FORCE
+
+help:
+	@echo "make reproduce   venv -> mathjax -> notebooks (papermill) -> book; prints the HTML path"
+	@echo "make test        venv, ruff, pytest (tests/), nbval on book/notebooks, book build, browser check"
+	@echo "make venv        create/refresh .venv from requirements.txt (skipped when up to date)"
+	@echo "make mathjax     local MathJax $(MATHJAX_VERSION) (npm) into $(MATHJAX_DIR)"
+	@echo "make chromium    install Debian chromium if $(CHROMIUM) is missing"
+	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
+	@echo "make book        jupyter-book build book -W (offline)"
+	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
+	@echo "make clean       remove book/_build, build/, $(MATHJAX_DIR) (keeps results/, data/cache/)"
+	@echo "make distclean   clean + remove .venv"
+
+# ---------------------------------------------------------------------------------------------
+# venv: reused without calling pip while the hash of requirements.txt + pyproject.toml matches.
+# PIP_NOISE drops pip's warnings about empty local index folders on the project's machines.
+PIP_NOISE := { grep -v "^WARNING: Location 'file:" || true; }
+venv:
+	@hash=$$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1); \
+	if [ -x $(PY) ] && $(PY) -c '' 2>/dev/null && [ "$$(cat $(VENV_STAMP) 2>/dev/null)" = "$$hash" ]; then \
+	  echo "venv: $(VENV) up to date ($${hash:0:12})"; exit 0; \
+	fi; \
+	t0=$$(date +%s); \
+	if ! { [ -x $(PY) ] && $(PY) -c '' 2>/dev/null; }; then \
+	  rm -rf $(VENV); echo "venv: creating $(VENV) with $(PYTHON_BOOTSTRAP)"; \
+	  $(PYTHON_BOOTSTRAP) -m venv $(VENV); \
+	fi; \
+	rm -f $(VENV_STAMP); \
+	echo "venv: installing requirements.txt"; \
+	$(PY) -m pip install --quiet --no-input --progress-bar off -r requirements.txt 2>&1 | $(PIP_NOISE); \
+	$(PY) -m pip install --quiet --no-input --no-deps --no-build-isolation -e . 2>&1 | $(PIP_NOISE); \
+	$(PY) -m pip check; \
+	$(PY) -c 'import importlib.metadata as m, sys; v = m.version("torch"); \
+	  sys.exit(None if v.split("+")[0] == "2.13.0" else f"venv: torch {v} installed, 2.13.0 pinned")'; \
+	$(PY) -m ipykernel install --sys-prefix --name python3 --display-name "Python 3 (nctwin)" >/dev/null; \
+	echo "$$hash" > $(VENV_STAMP); \
+	echo "venv: ready in $$(( $$(date +%s) - t0 )) s"
+
+# ---------------------------------------------------------------------------------------------
+# mathjax: the book loads MathJax from its own _static/mathjax/ (no CDN). tex-svg.js loads its es5
+# siblings, so the whole es5/ directory is copied. Source dir is book/_vendor/, not book/_static/:
+# see the comment at the top of book/_config.yml.
+mathjax:
+	@if [ -f $(MATHJAX_DIR)/tex-svg.js ] && [ "$$(cat $(MATHJAX_DIR)/VERSION 2>/dev/null)" = "$(MATHJAX_VERSION)" ]; then \
+	  echo "mathjax: $(MATHJAX_DIR) holds MathJax $(MATHJAX_VERSION)"; exit 0; \
+	fi; \
+	mkdir -p $(NPM_CACHE); \
+	tgz=$(NPM_CACHE)/mathjax-$(MATHJAX_VERSION).tgz; \
+	if [ ! -s $$tgz ]; then \
+	  tmp=$$(mktemp -d $(NPM_CACHE)/pack.XXXXXX); \
+	  (cd $$tmp && npm pack --silent mathjax@$(MATHJAX_VERSION) >/dev/null); \
+	  mv $$tmp/mathjax-$(MATHJAX_VERSION).tgz $$tgz; rm -rf $$tmp; \
+	fi; \
+	tmp=$$(mktemp -d $(NPM_CACHE)/x.XXXXXX); \
+	tar -xzf $$tgz -C $$tmp package/es5 package/LICENSE; \
+	rm -rf $(MATHJAX_DIR); mkdir -p $(dir $(MATHJAX_DIR)); \
+	mv $$tmp/package/es5 $(MATHJAX_DIR); mv $$tmp/package/LICENSE $(MATHJAX_DIR)/LICENSE; \
+	rm -rf $$tmp; echo "$(MATHJAX_VERSION)" > $(MATHJAX_DIR)/VERSION; \
+	echo "mathjax: MathJax $(MATHJAX_VERSION) es5/ -> $(MATHJAX_DIR)"
+
+chromium:
+	@if [ -x $(CHROMIUM) ]; then echo "chromium: $(CHROMIUM) present"; exit 0; fi; \
+	sudo=; [ "$$(id -u)" = 0 ] || sudo=sudo; \
+	echo "chromium: installing Debian chromium with apt-get"; \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q; \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium
+
+# ---------------------------------------------------------------------------------------------
+# notebooks: papermill, headless, cwd = repo root (notebooks write results/<stem>/...). The output
+# goes to build/papermill/ first and replaces book/notebooks/<name> only on success.
+# `make notebooks` re-executes all; `make book`/`make test` execute only those whose executed copy
+# is missing (order-only prerequisites: a fresh clone's file times never trigger a re-run).
+NB_FORCE :=
+book/notebooks/%.ipynb: $(NB_FORCE) | notebooks/%.ipynb venv
+	@mkdir -p book/notebooks build/papermill
+	@src=notebooks/$*.ipynb; tmp=build/papermill/$*.ipynb; t0=$$(date +%s); \
+	echo "notebooks: executing $$src"; \
+	if ! $(VENV)/bin/papermill --cwd "$(CURDIR)" -k python3 --no-progress-bar \
+	     "$$src" "$$tmp"; then \
+	  echo "notebooks: $$src FAILED; the partly executed notebook is $$tmp" >&2; exit 1; \
+	fi; \
+	mv "$$tmp" "$@"; echo "notebooks: $@ ($$(( $$(date +%s) - t0 )) s)"
+
+notebooks: venv
+	@if [ -z "$(strip $(EXECUTED))" ]; then echo "notebooks: notebooks/ holds no notebook"; exit 0; fi; \
+	$(MAKE) --no-print-directory NB_FORCE=FORCE $(EXECUTED)
+
+FORCE:
+
+# ---------------------------------------------------------------------------------------------
+book: venv mathjax | $(EXECUTED)
+	@mkdir -p build; t0=$$(date +%s); \
+	$(VENV)/bin/jupyter-book build book --all -W --keep-going --builder html 2>&1 | tee build/book.log; \
+	echo "book: built in $$(( $$(date +%s) - t0 )) s"; \
+	echo "book: $(CURDIR)/$(HTML_DIR)/index.html"
+
+reproduce: venv mathjax notebooks book
+	@echo "reproduce: done; open $(CURDIR)/$(HTML_DIR)/index.html"
+
+# ---------------------------------------------------------------------------------------------
+test: venv lint unit nbval browser
+	@echo "test: all steps passed"
+
+lint: venv
+	$(VENV)/bin/ruff check $(wildcard src tests benchmarks)
+
+unit: venv
+	$(PY) -m pytest
+
+nbval: venv | $(EXECUTED)
+	@shopt -s nullglob; nbs=(book/notebooks/*.ipynb); \
+	if [ $${#nbs[@]} -eq 0 ]; then echo "nbval: book/notebooks/ holds no executed notebook; skipped"; exit 0; fi; \
+	echo "nbval: $${nbs[*]}"; \
+	$(PY) -m pytest --nbval-lax --nbval-current-env -p no:cacheprovider "$${nbs[@]}"
+
+browser: book chromium
+	@t0=$$(date +%s); \
+	$(PY) tests/browser/check_book.py --chromium $(CHROMIUM) $(HTML_DIR); \
+	echo "browser: checked in $$(( $$(date +%s) - t0 )) s"
+
+bench: venv
+	@shopt -s nullglob; scripts=(benchmarks/*.py); \
+	if [ $${#scripts[@]} -eq 0 ]; then echo "bench: benchmarks/ holds no script" >&2; exit 0; fi; \
+	for s in "$${scripts[@]}"; do echo "bench: $$s" >&2; $(PY) "$$s"; done
+
+# ---------------------------------------------------------------------------------------------
+clean:
+	rm -rf book/_build build $(MATHJAX_DIR)
+
+distclean: clean
+	rm -rf $(VENV)
