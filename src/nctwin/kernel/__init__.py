@@ -1,0 +1,1 @@
+"""Virtual NC kernels: each is ``run(toolpath, machine) -> Motion``."""
