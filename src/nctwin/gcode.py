@@ -302,15 +302,15 @@ def _lex(b: np.ndarray, errors: _Errors) -> dict[str, np.ndarray]:
         word = letters[np.searchsorted(letters, pos, side="right") - 1]
         errors.at_pos(int(pos), f"malformed number after word {chr(b[word])}")
 
-    # numbers are read by C (strtod: correctly rounded, as Python's float) up to the first error
+    # numbers are read as Python reads floats (correctly rounded), up to the first error
     cut = min(errors.first_pos(), int(letters[malformed][0]) if malformed.any() else 1 << 62)
     n_ok = int(np.searchsorted(letters, cut))
     value = np.full(len(letters), np.nan)
-    value[:n_ok] = np.fromstring(_SPACE[b[:cut]].tobytes(), sep=" ")
+    value[:n_ok] = np.array(_SPACE[b[:cut]].tobytes().split(), dtype=np.float64)
     big = np.isinf(value)
     for pos in letters[big][:1]:
         errors.at_pos(int(pos), "number out of range")
-    line = np.cumsum(is_nl)[letters]  # newlines before each letter
+    line = np.searchsorted(errors.line_starts, letters, side="right") - 1
     keep = ~(bad_letter | malformed | big) & (np.arange(len(letters)) < n_ok)
     return {"code": codes[keep].astype(np.int64), "value": value[keep], "line": line[keep]}
 

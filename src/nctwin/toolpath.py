@@ -275,6 +275,16 @@ class Toolpath:
         tol[self.path_mode >= PathMode.EXACT_PATH] = 0.0
         return tol
 
+    def take(self, blocks: np.ndarray) -> Toolpath:
+        """The tool path of the given blocks (indices or mask, in order); events are kept and
+        re-pointed to the next kept block."""
+        idx = np.arange(len(self))[blocks]
+        ev = self.events.copy()
+        ev["block"] = np.searchsorted(idx, ev["block"], side="left")
+        names = ("start_mm", "end_mm", "kind", "feed_mm_s", "center_mm", "plane", "dwell_s",
+                 "line", "path_mode", "blend_tol_mm", "naive_tol_mm")  # fmt: skip
+        return Toolpath(**{n: getattr(self, n)[idx] for n in names}, events=ev)
+
     def kind_counts(self) -> dict[str, int]:
         """Number of blocks per kind, keyed by lower-case kind name."""
         counts = np.bincount(self.kind, minlength=len(MotionKind))
