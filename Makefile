@@ -47,7 +47,7 @@ help:
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
-	@echo "make clean       remove book/_build, build/, $(MATHJAX_DIR) (keeps results/, data/cache/)"
+	@echo "make clean       remove book/_build, build/, book/_vendor/ (keeps results/, data/cache/)"
 	@echo "make distclean   clean + remove .venv"
 
 # ---------------------------------------------------------------------------------------------
@@ -157,14 +157,15 @@ browser: book chromium
 	$(PY) tests/browser/check_book.py --chromium $(CHROMIUM) $(HTML_DIR); \
 	echo "browser: checked in $$(( $$(date +%s) - t0 )) s"
 
+# bench: every benchmarks/*.py except helper modules (_common.py, ...); JSON lines on stdout.
 bench: venv
-	@shopt -s nullglob; scripts=(benchmarks/*.py); \
+	@shopt -s nullglob; scripts=(benchmarks/[!_]*.py); \
 	if [ $${#scripts[@]} -eq 0 ]; then echo "bench: benchmarks/ holds no script" >&2; exit 0; fi; \
 	for s in "$${scripts[@]}"; do echo "bench: $$s" >&2; $(PY) "$$s"; done
 
 # ---------------------------------------------------------------------------------------------
 clean:
-	rm -rf book/_build build $(MATHJAX_DIR)
+	rm -rf book/_build build book/_vendor
 
 distclean: clean
 	rm -rf $(VENV)
