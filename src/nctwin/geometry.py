@@ -1,0 +1,78 @@
+"""Points of a tool path by arc length.
+
+:class:`PathGeometry` turns a :class:`~nctwin.toolpath.Toolpath` into a function of arc length
+``s`` (mm from the start of the program): the position on lines, arcs and helices, evaluated for
+many ``s`` at once. Kernels sample their command positions with it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .toolpath import PLANE_AXES, Toolpath
+
+__all__ = ["PathGeometry"]
+
+
+class PathGeometry:
+    """Arc-length parametrisation of a tool path.
+
+    Parameters
+    ----------
+    toolpath : Toolpath
+
+    Attributes
+    ----------
+    s_start_mm : ndarray, shape (N + 1,)
+        Arc length at the start of each block, and the total length last.
+    """
+
+    def __init__(self, toolpath: Toolpath) -> None:
+        tp = toolpath
+        self.toolpath = tp
+        self.lengths_mm = tp.lengths_mm
+        self.s_start_mm = np.concatenate([[0.0], np.cumsum(self.lengths_mm)])
+        self.total_mm = float(self.s_start_mm[-1])
+        self._arc = tp.is_arc
+        ax = PLANE_AXES[tp.plane]
+        rows = np.arange(len(tp))
+        rel = tp.start_mm - tp.center_mm
+        self._ax = ax
+        self._theta0 = np.arctan2(rel[rows, ax[:, 1]], rel[rows, ax[:, 0]])
+        d = tp.end_mm - tp.start_mm
+        self._dn = d[rows, ax[:, 2]]
+        self._sweep = tp.sweep_rad
+        rel_end = tp.end_mm - tp.center_mm
+        self._r0 = np.hypot(rel[rows, ax[:, 0]], rel[rows, ax[:, 1]])
+        self._r1 = np.hypot(rel_end[rows, ax[:, 0]], rel_end[rows, ax[:, 1]])
+
+    def block_at(self, s_mm: np.ndarray) -> np.ndarray:
+        """Index of the block containing each arc length, shape like ``s_mm``."""
+        k = np.searchsorted(self.s_start_mm, s_mm, side="right") - 1
+        return np.clip(k, 0, max(len(self.lengths_mm) - 1, 0))
+
+    def points(self, s_mm: np.ndarray) -> np.ndarray:
+        """Positions at arc lengths ``s_mm`` (clipped to the path), shape (len(s_mm), 3)."""
+        tp = self.toolpath
+        if len(tp) == 0:
+            return np.zeros((len(s_mm), 3))
+        s = np.clip(s_mm, 0.0, self.total_mm)
+        k = self.block_at(s)
+        length = self.lengths_mm[k]
+        frac = np.divide(s - self.s_start_mm[k], length, out=np.zeros_like(s), where=length > 0)
+        frac = np.clip(frac, 0.0, 1.0)
+        out = tp.start_mm[k] + frac[:, None] * (tp.end_mm[k] - tp.start_mm[k])
+        arc = self._arc[k]
+        if arc.any():
+            ka, fa = k[arc], frac[arc]
+            ax = self._ax[ka]
+            phi = self._theta0[ka] + self._sweep[ka] * fa
+            r = self._r0[ka] + (self._r1[ka] - self._r0[ka]) * fa  # exact at both ends
+            c = tp.center_mm[ka]
+            rows = np.arange(len(ka))
+            p = np.empty((len(ka), 3))
+            p[rows, ax[:, 0]] = c[rows, ax[:, 0]] + r * np.cos(phi)
+            p[rows, ax[:, 1]] = c[rows, ax[:, 1]] + r * np.sin(phi)
+            p[rows, ax[:, 2]] = tp.start_mm[ka][rows, ax[:, 2]] + self._dn[ka] * fa
+            out[arc] = p
+        return out

@@ -1,0 +1,448 @@
+r"""FIR-filter interpolation with corner blending within a tolerance, and look-ahead.
+
+The "NC kernel simulator" of Chien, Sencer & Ward (2023, Sec. 4), after the FIR interpolation
+of Tajima & Sencer (2018) and Hayasaka et al. (2019): every block is commanded as a velocity pulse
+along the path; a cascade of two moving-average (FIR) filters of lengths :math:`T_1` and
+:math:`T_2` smooths the pulses. A straight line of length :math:`L` at feed :math:`F` takes exactly
+
+.. math:: t = L / F + T_1 + T_2,
+
+with acceleration :math:`A = F / T_1` and jerk :math:`J = F / (T_1 T_2)`.
+
+Where consecutive pulses overlap in the filter window, the filtered path cuts the corner. For an
+isolated corner of angle :math:`\theta` passed at speed :math:`V` the deviation from the corner is
+
+.. math:: \varepsilon = V \sin(\theta / 2) \, \frac{3 T_1^2 + T_2^2}{12\, T_1}
+   \qquad (T_1 \ge T_2),
+
+derived in :func:`corner_deviation_mm`. The kernel plans, for every junction, the highest speed
+whose filtered path stays within the blending tolerance of the corner:
+
+* **Local blending.** An isolated sharp corner: the speed is lowered so that the deviation is the
+  tolerance.
+* **Global blending.** Where the filter window spans several short blocks, they are averaged
+  together; the deviation is evaluated on the filtered polyline itself (the discrete filter
+  applied to the path at constant speed), so a series of short segments on a smooth curve keeps
+  a high feed and the feed drops only as far as the deviation requires.
+* **Look-ahead.** A reduced junction speed is commanded over the filter window centred on the
+  junction (half a window before, half after), so the tool slows before the corner; where windows
+  of several junctions overlap the lowest speed wins. Block feeds are capped by the axis velocity
+  limits, by ``A_axis * T1`` per axis (so that no velocity step exceeds the axis acceleration
+  once filtered), by the centripetal acceleration and filter shrinkage on arcs.
+* G61/G61.1, a zero tolerance and dwells stop the tool: the command waits one filter length so
+  the filters drain, then dwells.
+
+Conventions: the filters act on the command positions sampled at the interpolation period
+``Ts``; a box of ``T/Ts + 1`` taps ramps a velocity step over exactly ``T``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import PathGeometry
+from ..machine import MachineProfile
+from ..motion import Motion
+from ..toolpath import MotionKind, Toolpath
+
+__all__ = ["FirFilter", "corner_deviation_mm", "plan", "run"]
+
+
+@dataclass(frozen=True)
+class FirFilter:
+    """The two-stage moving-average filter of the interpolator.
+
+    Parameters
+    ----------
+    t1_s, t2_s : float
+        Lengths of the two moving averages (``t1_s >= period_s``).
+    period_s : float
+        Interpolation period.
+    """
+
+    t1_s: float
+    t2_s: float
+    period_s: float
+
+    def __post_init__(self) -> None:
+        if not self.period_s > 0:
+            raise ValueError(f"period_s = {self.period_s!r} is out of range: allowed (0, 0.1]")
+        for name in ("t1_s", "t2_s"):
+            v = getattr(self, name)
+            lo = self.period_s if name == "t1_s" else 0.0
+            if not (lo <= v <= 10.0):
+                raise ValueError(f"fir_{name} = {v!r} is out of range for the FIR kernel: "
+                                 f"allowed [{lo:g}, 10]")  # fmt: skip
+
+    @classmethod
+    def of(cls, machine: MachineProfile) -> FirFilter:
+        """The filter of a machine profile (the longer time constant first)."""
+        t1, t2 = max(machine.fir_t1_s, machine.fir_t2_s), min(machine.fir_t1_s, machine.fir_t2_s)
+        return cls(t1, t2, machine.period_s)
+
+    @property
+    def taps(self) -> tuple[int, int]:
+        """Number of taps of each box: ``T / Ts + 1``."""
+        return (int(round(self.t1_s / self.period_s)) + 1, int(round(self.t2_s / self.period_s)) + 1)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Impulse response of the cascade, shape (n1 + n2 - 1,); sums to 1."""
+        n1, n2 = self.taps
+        return np.convolve(np.full(n1, 1.0 / n1), np.full(n2, 1.0 / n2))
+
+    @property
+    def length_s(self) -> float:
+        """Duration over which the cascade spreads a step: ``T1 + T2`` (as sampled)."""
+        return (len(self.weights) - 1) * self.period_s
+
+    @property
+    def variance_s2(self) -> float:
+        """Variance of the impulse response in time (s^2): sets the shrinkage of arcs."""
+        w = self.weights
+        k = np.arange(len(w)) * self.period_s
+        mean = (w * k).sum()
+        return float((w * (k - mean) ** 2).sum())
+
+    def apply(self, x: np.ndarray) -> np.ndarray:
+        """Filter sampled positions ``x`` (n, 3) that start and end at rest.
+
+        Returns shape (n + n1 + n2 - 2, 3): the input is held at its first and last value
+        outside its span. Each box is a difference of running sums, O(n); the sums run over
+        positions relative to the start, which keeps their rounding below 1e-7 mm.
+        """
+        out = x - x[0]
+        for n in self.taps:
+            if n > 1:
+                held = np.empty((len(out) + 2 * n - 1, 3))
+                held[:n] = 0.0
+                held[n : n + len(out)] = out
+                held[n + len(out) :] = out[-1]
+                c = np.cumsum(held, axis=0)
+                out = c[n:] - c[:-n]
+                out /= n
+        return out + x[0]
+
+
+def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
+    r"""Deviation from an isolated corner filtered at constant speed (continuous time).
+
+    The filtered velocity is :math:`V(u_1 + (u_2 - u_1) S(t))`, with :math:`S` the step response
+    of the cascade. At the middle of the transition the tool is at
+    :math:`C + V (u_2 - u_1) \int_0^{T/2} S`, and :math:`|u_2 - u_1| = 2 \sin(\theta/2)`. With
+    :math:`T_1 \ge T_2`, :math:`\int_0^{(T_1+T_2)/2} S = (3 T_1^2 + T_2^2) / (24 T_1)`.
+
+    Parameters
+    ----------
+    speed_mm_s : float or ndarray
+    angle_rad : float or ndarray
+        Change of direction at the corner (0 = straight on).
+    t1_s, t2_s : float
+        Filter lengths.
+    """
+    t1, t2 = max(t1_s, t2_s), min(t1_s, t2_s)
+    return speed_mm_s * np.sin(np.asarray(angle_rad) / 2) * (3 * t1**2 + t2**2) / (12 * t1)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the look-ahead decided, per block and per junction.
+
+    Parameters
+    ----------
+    feed_mm_s : ndarray, shape (N,)
+        Cruise feed of each block after the machine's limits.
+    junction_mm_s : ndarray, shape (N + 1,)
+        Speed at the start of each block (index N: the end of the program); 0 is a stop.
+    pause_s : ndarray, shape (N + 1,)
+        Time the command waits at each junction (filter drain before a stop, dwells).
+    """
+
+    feed_mm_s: np.ndarray
+    junction_mm_s: np.ndarray
+    pause_s: np.ndarray
+
+
+def _block_feeds(tp: Toolpath, machine: MachineProfile, fir: FirFilter) -> np.ndarray:
+    """Cruise feed of each block (mm/s), shape (N,): programmed feed within every limit."""
+    kind = tp.kind
+    f = np.where(kind == MotionKind.RAPID, machine.rapid_feed_mm_s,
+                 np.minimum(np.nan_to_num(tp.feed_mm_s, nan=np.inf), machine.max_feed_mm_s))  # fmt: skip
+    vmax = np.asarray(machine.axis_max_velocity_mm_s)
+    amax = np.asarray(machine.axis_max_acceleration_mm_s2)
+    jmax = np.asarray(machine.axis_max_jerk_mm_s3)
+    # largest share of the feed any axis takes: chord direction for lines, full for arc planes
+    share = np.abs(tp.directions)
+    arc = tp.is_arc
+    if arc.any():
+        ax = tp._plane_axes[arc]
+        rows = np.arange(int(arc.sum()))
+        s = np.abs(tp.start_tangents[arc])
+        s[rows, ax[:, 0]] = 1.0
+        s[rows, ax[:, 1]] = 1.0
+        share[arc] = s
+    with np.errstate(divide="ignore"):
+        step = amax * fir.t1_s
+        if fir.t2_s > 0:
+            step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
+        f = np.minimum(f, np.min(np.minimum(vmax, step) / share, axis=1))
+        if arc.any():
+            r = tp.radius_mm[arc]
+            a_plane = np.minimum(amax[ax[:, 0]], amax[ax[:, 1]])
+            tol = tp.effective_tolerance_mm(machine.blend_tol_mm)[arc]
+            v_arc = np.sqrt(a_plane * r)  # centripetal acceleration
+            v_shrink = np.sqrt(2.0 * r * tol / fir.variance_s2)  # radial shrink of the filter
+            f[arc] = np.minimum(f[arc], np.minimum(v_arc, v_shrink))
+    f[kind == MotionKind.DWELL] = np.inf
+    return f
+
+
+def _filtered_deviation(geo, s_mm, point_mm, speed_mm_s, fir: FirFilter) -> np.ndarray:
+    """Distance from each junction to the filtered path, the path run at constant speed.
+
+    The filter output at the junction's passing time is the weighted mean of the path points
+    ``speed * Ts * (c - m)`` ahead (``c`` the centre tap), which is what the kernel computes when
+    the speed is constant over the window. Consecutive taps are pooled into at most
+    :data:`DEVIATION_NODES` nodes (weights summed, offsets averaged), exact wherever the path is
+    straight within a node. Shape (K,).
+    """
+    w, offsets = _deviation_nodes(fir)
+    s = s_mm[:, None] + speed_mm_s[:, None] * offsets[None, :]
+    pts = geo.points(s.ravel()).reshape(len(s_mm), len(w), 3)
+    filt = np.einsum("l,klc->kc", w, pts)
+    return np.linalg.norm(filt - point_mm, axis=1)
+
+
+#: Share of the tolerance kept in reserve: the plan evaluates the filter at the junction's
+#: passing time, the samples fall up to half a period beside it (measured: < 0.05 %).
+PHASE_MARGIN = 0.002
+
+#: Relative precision of planned junction speeds (or of the deviation reaching the tolerance).
+V_RTOL = 0.002
+
+#: Quadrature nodes of the deviation check (pooled filter taps).
+DEVIATION_NODES = 24
+
+
+def _deviation_nodes(fir: FirFilter) -> tuple[np.ndarray, np.ndarray]:
+    """Pooled weights and time offsets (s) of the filter taps, centred on the middle tap."""
+    w = fir.weights
+    offsets = (0.5 * (len(w) - 1) - np.arange(len(w))) * fir.period_s
+    nodes = min(DEVIATION_NODES, len(w))
+    groups = np.arange(len(w)) * nodes // len(w)
+    wg = np.bincount(groups, weights=w)
+    og = np.bincount(groups, weights=w * offsets) / wg
+    return wg, og
+
+
+def plan(tp: Toolpath, machine: MachineProfile, fir: FirFilter | None = None) -> Plan:
+    """Look-ahead: cruise feeds, junction speeds and pauses (see the module docstring)."""
+    fir = fir or FirFilter.of(machine)
+    n = len(tp)
+    geo = PathGeometry(tp)
+    feed = _block_feeds(tp, machine, fir)
+    v = np.zeros(n + 1)
+    pause = np.zeros(n + 1)
+    if n == 0:
+        return Plan(feed, v, pause)
+    amax = np.asarray(machine.axis_max_acceleration_mm_s2)
+    jmax = np.asarray(machine.axis_max_jerk_mm_s3)
+    tol = tp.effective_tolerance_mm(machine.blend_tol_mm)
+    dwell = tp.kind == MotionKind.DWELL
+
+    j = np.arange(1, n)  # junction j: end of block j-1, start of block j
+    cap = np.minimum(feed[j - 1], feed[j])
+    # a velocity step across the corner, per axis, is smoothed over T1 (acceleration), T1 T2 (jerk)
+    du = np.abs(tp.start_tangents[j] - tp.end_tangents[j - 1])
+    with np.errstate(divide="ignore"):
+        step = amax * fir.t1_s
+        if fir.t2_s > 0:
+            step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
+        cap = np.minimum(cap, np.min(step / du, axis=1))
+    stop = dwell[j] | dwell[j - 1] | (tol[j] == 0)
+    cap[stop] = 0.0
+    v[j] = cap
+    # contour deviation within the tolerance of the block that starts at the junction
+    check = np.flatnonzero((cap > 0) & np.isfinite(tol[j]))
+    if len(check):
+        jj = j[check]
+        s_j, p_j, tol_j = geo.s_start_mm[jj], tp.start_mm[jj], tol[jj] * (1 - PHASE_MARGIN)
+        hi = cap[check].copy()
+        e_hi = _filtered_deviation(geo, s_j, p_j, hi, fir)
+        # largest V with e(V) <= tol: secant steps on log e over log V (e ~ V for a local
+        # corner, ~ V^2 for a smooth curve) alternating with bisection of the bracket [lo, hi]
+        lo, e_lo = np.zeros_like(hi), np.zeros_like(hi)
+        active = np.flatnonzero(e_hi > tol_j)
+        for it in range(60):
+            if not len(active):
+                break
+            a = active
+            with np.errstate(divide="ignore", invalid="ignore"):
+                slope = np.where(lo[a] > 0, np.log(e_hi[a] / e_lo[a]) / np.log(hi[a] / lo[a]), 1.0)
+                slope = np.clip(np.nan_to_num(slope, nan=1.0), 0.5, 4.0)
+                guess = hi[a] * (tol_j[a] / e_hi[a]) ** (1.0 / slope)
+            inside = (guess > lo[a]) & (guess < hi[a]) & (it % 2 == 0)  # odd steps bisect
+            guess = np.where(inside, guess, 0.5 * (lo[a] + hi[a]))
+            e = _filtered_deviation(geo, s_j[a], p_j[a], guess, fir)
+            ok = e <= tol_j[a]
+            lo[a[ok]], e_lo[a[ok]] = guess[ok], e[ok]
+            hi[a[~ok]], e_hi[a[~ok]] = guess[~ok], e[~ok]
+            done = (hi[a] - lo[a] <= V_RTOL * hi[a]) | (e_lo[a] >= (1 - V_RTOL) * tol_j[a])
+            active = a[~done]
+        v[jj] = np.where(e_hi <= tol_j, hi, lo)
+    # waiting: the filters drain before a stop (not after a dwell, already at rest), and dwells
+    drain = (v[:n] == 0) & np.concatenate([[False], ~dwell[:-1]])
+    drain[0] = False
+    pause[:n] = np.where(drain, fir.length_s, 0.0) + np.where(dwell, tp.dwell_s, 0.0)
+    return Plan(feed, v, pause)
+
+
+def _range_min(n: int, lo: np.ndarray, hi: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """For each of ``n`` cells, the minimum ``value`` of the ranges ``[lo, hi)`` covering it
+    (``inf`` where none does). O((n + ranges) log n), without a Python loop over ranges."""
+    out = np.full(n, np.inf)
+    if n == 0 or len(lo) == 0:
+        return out
+    levels = max(1, int(np.ceil(np.log2(n))) + 1)
+    tables = [np.full(n, np.inf) for _ in range(levels)]
+    length = hi - lo
+    keep = length > 0
+    lo, hi, value, length = lo[keep], hi[keep], value[keep], length[keep]
+    k = np.floor(np.log2(np.maximum(length, 1))).astype(np.int64)
+    # each range is the union of two blocks of size 2**k: [lo, lo+2**k) and [hi-2**k, hi)
+    for level in np.unique(k):
+        m = k == level
+        np.minimum.at(tables[level], lo[m], value[m])
+        np.minimum.at(tables[level], hi[m] - (1 << int(level)), value[m])
+    for level in range(levels - 1, 0, -1):  # push blocks of 2**level down to halves
+        half = 1 << (level - 1)
+        t, below = tables[level], tables[level - 1]
+        np.minimum(below, t, out=below)
+        np.minimum(below[half:], t[:-half] if half < n else t[:0], out=below[half:])
+    return tables[0]
+
+
+def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter):
+    """Piecewise-constant speed command: knots of arc length over time, and the block executed
+    in each time segment. Returns ``(t_knots, s_knots, seg_t0, seg_block)``."""
+    n = len(tp)
+    s_start = geo.s_start_mm
+    half = 0.5 * fir.length_s + 2 * fir.period_s  # the window, and a margin for sampling
+    v = p.junction_mm_s
+    zone = (v > 0) & np.isfinite(v)
+    z_lo = np.maximum(s_start[zone] - v[zone] * half, 0.0)
+    z_hi = np.minimum(s_start[zone] + v[zone] * half, geo.total_mm)
+    cuts = np.unique(np.concatenate([s_start, z_lo, z_hi]))
+    ds = np.diff(cuts)
+    mid = 0.5 * (cuts[:-1] + cuts[1:])
+    block = geo.block_at(mid)
+    speed = p.feed_mm_s[block].copy()
+    if zone.any():
+        i_lo = np.searchsorted(cuts, z_lo)
+        i_hi = np.searchsorted(cuts, z_hi)
+        speed = np.minimum(speed, _range_min(len(ds), i_lo, i_hi, v[zone]))
+    dur = ds / speed
+    # pauses sit at the cut where their junction is
+    at = np.searchsorted(cuts, s_start)
+    pause_at = np.zeros(len(cuts))
+    np.add.at(pause_at, at, p.pause_s)
+    # time knots: arrive at each cut, then wait its pause
+    arrive = np.concatenate([[0.0], np.cumsum(dur)]) + np.concatenate([[0.0], np.cumsum(pause_at)[:-1]])
+    leave = arrive + pause_at
+    t_knots = np.column_stack([arrive, leave]).ravel()
+    s_knots = np.repeat(cuts, 2)
+    # block of each time segment: moving segments, and pauses (a dwell's own block, else the
+    # block that ends at the stop)
+    pause_block = np.full(len(cuts), -1)
+    owner = np.where(tp.kind == MotionKind.DWELL, np.arange(n), np.maximum(np.arange(n) - 1, 0))
+    has = p.pause_s[:n] > 0
+    pause_block[at[:n][has]] = owner[has]
+    seg_t0 = t_knots[:-1]
+    seg_block = np.column_stack([np.where(pause_block >= 0, pause_block, -1),
+                                 np.append(block, block[-1] if len(block) else 0)]).ravel()[:-1]  # fmt: skip
+    seg_block = np.where(seg_block < 0, np.roll(seg_block, -1), seg_block)
+    return t_knots, s_knots, seg_t0, seg_block
+
+
+#: Largest distance between an arc and the chords the command is interpolated on (mm).
+ARC_CHORD_TOL_MM = 1e-6
+
+
+def _refine_arcs(tp: Toolpath, geo: PathGeometry, t_knots, s_knots):
+    """Add knots inside arcs so that interpolating positions linearly in time between knots
+    stays within :data:`ARC_CHORD_TOL_MM` of the arc (speed is constant between knots)."""
+    ds = np.diff(s_knots)
+    if not tp.is_arc.any() or not len(ds):
+        return t_knots, s_knots
+    mid = 0.5 * (s_knots[:-1] + s_knots[1:])
+    b = geo.block_at(mid)
+    r = np.where(tp.is_arc[b], tp.radius_mm[b], np.inf)
+    r = np.where(r > 0, r, np.inf)
+    # chord of angle dphi deviates r (1 - cos(dphi / 2)) ~ r dphi^2 / 8 from the arc
+    dphi = np.sqrt(8.0 * ARC_CHORD_TOL_MM / r)
+    with np.errstate(invalid="ignore"):
+        planar = np.abs(tp.sweep_rad[b]) * np.divide(ds, geo.lengths_mm[b], out=np.zeros_like(ds),
+                                                      where=geo.lengths_mm[b] > 0)  # fmt: skip
+    need = np.divide(planar, dphi, out=np.zeros_like(planar), where=dphi > 0)
+    parts = np.maximum(1, np.ceil(need).astype(np.int64))
+    if parts.max() == 1:
+        return t_knots, s_knots
+    seg = np.repeat(np.arange(len(ds)), parts)
+    frac = (np.arange(len(seg)) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[seg]
+    t_new = np.append(t_knots[seg] + frac * np.diff(t_knots)[seg], t_knots[-1])
+    s_new = np.append(s_knots[seg] + frac * ds[seg], s_knots[-1])
+    return t_new, s_new
+
+
+def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
+    """Interpolate a tool path on the FIR kernel.
+
+    Parameters
+    ----------
+    toolpath : Toolpath
+    machine : MachineProfile
+        Supplies ``fir_t1_s``, ``fir_t2_s``, ``period_s``, ``blend_tol_mm``, the axis limits,
+        the rapid feed and the maximum feed.
+
+    Returns
+    -------
+    Motion
+        Samples every ``period_s`` from rest at the start to rest at the end.
+    """
+    fir = FirFilter.of(machine)
+    ts = fir.period_s
+    # zero-length moves are no-ops: plan without them, report the kept blocks' indices
+    kept = np.flatnonzero((toolpath.lengths_mm > 0) | (toolpath.kind == MotionKind.DWELL))
+    tp = toolpath.take(kept)
+    if len(tp) == 0:
+        z = np.zeros((1, 3))
+        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), ts)
+    geo = PathGeometry(tp)
+    p = plan(tp, machine, fir)
+    t_knots, s_knots, seg_t0, seg_block = _command(tp, geo, p, fir)
+    t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
+    x_knots = geo.points(s_knots)
+    n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
+    t_cmd = np.arange(n_cmd) * ts
+    x = np.column_stack([np.interp(t_cmd, t_knots, x_knots[:, a]) for a in range(3)])
+    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
+    pos = fir.apply(x)
+    n1, n2 = fir.taps
+    lag = n1 + n2 - 2
+    # exact rest at both ends (the filter's sums of equal values carry rounding)
+    moving = np.flatnonzero(np.any(x != x[0], axis=1))
+    first = moving[0] if len(moving) else len(x)
+    pos[:first] = x[0]
+    still = np.flatnonzero(np.any(x != x[-1], axis=1))
+    pos[(still[-1] + 1 + lag) if len(still) else 0 :] = x[-1]
+    vel = np.zeros_like(pos)
+    vel[1:] = np.diff(pos, axis=0) / ts
+    t = np.arange(len(pos)) * ts
+    # block of each sample: the command's block at the centre of the filter window
+    first_sample = np.ceil(seg_t0 / ts - 1e-9).astype(np.int64) + lag // 2
+    counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
+    counts[0] += min(first_sample[0], len(t))
+    block = np.repeat(seg_block, counts)
+    return Motion(t, pos, vel, kept[block], ts)
