@@ -1,7 +1,9 @@
 """The ``nctwin`` command line.
 
-``nctwin estimate PROGRAM [--machine NAME] [--method cam] [--json]`` prints the cycle time of a
-part program; ``nctwin machines`` lists the shipped machine profiles. Bad input ends with exit
+``nctwin estimate PROGRAM [--machine NAME] [--method cam|kernel] [--json]`` prints the cycle
+time of a part program; ``nctwin simulate PROGRAM [--machine NAME] [--plot feed.png]
+[--csv motion.csv] [--json]`` interpolates it on the FIR kernel; ``nctwin machines`` lists the
+shipped machine profiles. Bad input ends with exit
 code 2 and one line ``file:line: reason`` on standard error, never a traceback.
 """
 
@@ -26,31 +28,41 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("estimate", help="estimate the cycle time of a part program")
-    e.add_argument("program", help="G-code file")
+    _program_args(e)
     e.add_argument(
+        "--method", default="cam", choices=sorted(METHODS), help="estimator (default: cam)"
+    )
+    e.add_argument("--json", action="store_true", help="print machine-readable JSON")
+
+    m = sub.add_parser("simulate", help="interpolate a part program on the FIR kernel")
+    _program_args(m)
+    m.add_argument("--plot", metavar="PNG", help="write commanded vs actual feed over time")
+    m.add_argument("--csv", metavar="CSV", help="write the sampled motion")
+    m.add_argument("--json", action="store_true", help="print machine-readable JSON")
+
+    sub.add_parser("machines", help="list the shipped machine profiles")
+    return p
+
+
+def _program_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("program", help="G-code file")
+    p.add_argument(
         "--machine",
         default=DEFAULT_MACHINE,
         help=f"shipped profile name or .toml path (default: {DEFAULT_MACHINE})",
     )
-    e.add_argument(
-        "--method", default="cam", choices=sorted(METHODS), help="estimator (default: cam)"
-    )
-    e.add_argument(
+    p.add_argument(
         "--units",
         default="mm",
         choices=("mm", "inch"),
         help="units before the program's own G20/G21 (default: mm)",
     )
-    e.add_argument(
+    p.add_argument(
         "--dwell-p-unit",
         default="s",
         choices=("s", "ms"),
         help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc)",
     )
-    e.add_argument("--json", action="store_true", help="print machine-readable JSON")
-
-    sub.add_parser("machines", help="list the shipped machine profiles")
-    return p
 
 
 def _format_duration(seconds: float) -> str:
@@ -84,6 +96,51 @@ def _estimate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _simulate(args: argparse.Namespace) -> int:
+    from .kernel import fir
+
+    machine = load_machine(args.machine)
+    tp = parse_file(args.program, units=args.units, dwell_p_unit=args.dwell_p_unit)
+    motion = fir.run(tp, machine)
+    summary = {
+        "program": args.program,
+        "machine": machine.name,
+        "kernel": "fir",
+        "cycle_time_s": motion.cycle_time_s,
+        "length_mm": tp.length_mm,
+        "blocks": len(tp),
+        "samples": len(motion),
+        "period_s": motion.period_s,
+        "max_speed_mm_s": float(motion.speed_mm_s.max(initial=0.0)),
+    }
+    if args.csv:
+        motion.to_frame().to_csv(args.csv, index=False, float_format="%.6f")
+        summary["csv"] = args.csv
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plots import feed_profile
+
+        ax = feed_profile(motion, tp, machine, title=f"{args.program} on {machine.name}")
+        ax.figure.savefig(args.plot, dpi=120)
+        summary["plot"] = args.plot
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return 0
+    print(f"program      {args.program}")
+    print(f"machine      {machine.name} (FIR kernel)")
+    print(f"cycle time   {motion.cycle_time_s:.3f} s  ({_format_duration(motion.cycle_time_s)})")
+    print(f"path length  {tp.length_mm:.3f} mm")
+    print(f"blocks       {len(tp)}")
+    print(f"samples      {len(motion)} at {motion.period_s * 1e3:g} ms")
+    print(f"max speed    {summary['max_speed_mm_s']:.3f} mm/s")
+    for key in ("csv", "plot"):
+        if key in summary:
+            print(f"wrote        {summary[key]}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = _parser().parse_args(argv)
@@ -92,6 +149,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             for name in available_machines():
                 print(f"{name:<16} {load_machine(name).description}")
             return 0
+        if args.command == "simulate":
+            return _simulate(args)
         return _estimate(args)
     except GCodeError as exc:
         where = f"{exc.source}:{exc.line}" if exc.line else f"{exc.source}"
@@ -102,6 +161,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     except ValueError as exc:
         print(f"nctwin: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # an output file that cannot be written
+        print(f"nctwin: {exc.filename}: {exc.strerror}", file=sys.stderr)
         return 2
 
 

@@ -1,8 +1,9 @@
 """Sampled motion: what a kernel (virtual NC) outputs and what features and plots read.
 
 Conventions: samples at a fixed period, starting at ``t = 0``; positions in mm; velocities in
-mm/s. ``block[i]`` is the index (into the Toolpath) of the block the interpolator executes at
-sample ``i``.
+mm/s. Velocity, acceleration and jerk at sample ``i`` are backward differences (over the period
+ending at sample ``i``); they are 0 at the first sample. ``block[i]`` is the index (into the
+Toolpath) of the block the interpolator executes at sample ``i``.
 """
 
 from __future__ import annotations
@@ -59,10 +60,13 @@ class Motion:
 
     @property
     def acc_mm_s2(self) -> np.ndarray:
-        """Axis accelerations by central differences of the velocities, shape (n, 3)."""
-        if len(self) < 2:
-            return np.zeros_like(self.vel_mm_s)
-        return np.gradient(self.vel_mm_s, self.period_s, axis=0)
+        """Axis accelerations, backward differences of the velocities, shape (n, 3)."""
+        return _backward_diff(self.vel_mm_s, self.period_s)
+
+    @property
+    def jerk_mm_s3(self) -> np.ndarray:
+        """Axis jerks, backward differences of the accelerations, shape (n, 3)."""
+        return _backward_diff(self.acc_mm_s2, self.period_s)
 
     @property
     def cycle_time_s(self) -> float:
@@ -82,3 +86,9 @@ class Motion:
                 "block": self.block,
             }
         )
+
+
+def _backward_diff(x: np.ndarray, dt: float) -> np.ndarray:
+    out = np.zeros_like(x)
+    out[1:] = np.diff(x, axis=0) / dt
+    return out

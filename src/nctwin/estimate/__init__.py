@@ -1,4 +1,4 @@
-"""Cycle-time estimators that do not simulate the motion.
+"""Cycle-time estimators: analytic ones, and simulation on a virtual NC kernel.
 
 Each method is a function ``f(toolpath, machine) -> Estimate``; :data:`METHODS` maps the names
 the CLI accepts to them. Later chapters add their methods here.
@@ -11,12 +11,16 @@ from collections.abc import Callable
 from ..machine import MachineProfile
 from ..toolpath import Toolpath
 from .cam import cam
+from .kernel import kernel
 from .result import Estimate
 
-__all__ = ["METHODS", "Estimate", "cam", "estimate"]
+__all__ = ["METHODS", "Estimate", "cam", "estimate", "kernel"]
 
 #: Estimators by name.
-METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {"cam": cam}
+METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
+    "cam": cam,
+    "kernel": kernel,
+}
 
 
 def estimate(toolpath: Toolpath, machine: MachineProfile, method: str = "cam") -> Estimate:

@@ -73,8 +73,9 @@ class FirFilter:
             v = getattr(self, name)
             lo = self.period_s if name == "t1_s" else 0.0
             if not (lo <= v <= 10.0):
-                raise ValueError(f"fir_{name} = {v!r} is out of range for the FIR kernel: "
-                                 f"allowed [{lo:g}, 10]")  # fmt: skip
+                raise ValueError(
+                    f"fir_{name} = {v!r} is out of range for the FIR kernel: allowed [{lo:g}, 10]"
+                )
 
     @classmethod
     def of(cls, machine: MachineProfile) -> FirFilter:
@@ -85,7 +86,10 @@ class FirFilter:
     @property
     def taps(self) -> tuple[int, int]:
         """Number of taps of each box: ``T / Ts + 1``."""
-        return (int(round(self.t1_s / self.period_s)) + 1, int(round(self.t2_s / self.period_s)) + 1)
+        return (
+            round(self.t1_s / self.period_s) + 1,
+            round(self.t2_s / self.period_s) + 1,
+        )
 
     @property
     def weights(self) -> np.ndarray:
@@ -168,8 +172,11 @@ class Plan:
 def _block_feeds(tp: Toolpath, machine: MachineProfile, fir: FirFilter) -> np.ndarray:
     """Cruise feed of each block (mm/s), shape (N,): programmed feed within every limit."""
     kind = tp.kind
-    f = np.where(kind == MotionKind.RAPID, machine.rapid_feed_mm_s,
-                 np.minimum(np.nan_to_num(tp.feed_mm_s, nan=np.inf), machine.max_feed_mm_s))  # fmt: skip
+    f = np.where(
+        kind == MotionKind.RAPID,
+        machine.rapid_feed_mm_s,
+        np.minimum(np.nan_to_num(tp.feed_mm_s, nan=np.inf), machine.max_feed_mm_s),
+    )
     vmax = np.asarray(machine.axis_max_velocity_mm_s)
     amax = np.asarray(machine.axis_max_acceleration_mm_s2)
     jmax = np.asarray(machine.axis_max_jerk_mm_s3)
@@ -324,9 +331,40 @@ def _range_min(n: int, lo: np.ndarray, hi: np.ndarray, value: np.ndarray) -> np.
     return tables[0]
 
 
-def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter):
-    """Piecewise-constant speed command: knots of arc length over time, and the block executed
-    in each time segment. Returns ``(t_knots, s_knots, seg_t0, seg_block)``."""
+@dataclass(frozen=True)
+class _Command:
+    """Piecewise-constant speed command along the path.
+
+    ``cuts`` (C,) are arc lengths; interval ``i`` runs from ``cuts[i]`` to ``cuts[i+1]`` at
+    ``speed[i]`` inside block ``block[i]``; the command waits ``pause[c]`` at cut ``c``, in block
+    ``pause_block[c]``.
+    """
+
+    cuts: np.ndarray
+    speed: np.ndarray
+    block: np.ndarray
+    pause: np.ndarray
+    pause_block: np.ndarray
+
+    def knots(self, scale: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Time and arc-length knots (2C,) of the command, speeds multiplied by ``scale``."""
+        speed = self.speed if scale is None else self.speed * scale
+        dur = np.diff(self.cuts) / speed
+        arrive = np.concatenate([[0.0], np.cumsum(dur)])
+        arrive[1:] += np.cumsum(self.pause)[:-1]
+        t = np.column_stack([arrive, arrive + self.pause]).ravel()
+        return t, np.repeat(self.cuts, 2)
+
+    def segment_blocks(self) -> np.ndarray:
+        """Block of each of the 2C - 1 time segments between knots (pause, move, pause, ...)."""
+        moving = np.append(self.block, self.block[-1] if len(self.block) else 0)
+        seg = np.column_stack([self.pause_block, moving]).ravel()[:-1]
+        return np.where(seg < 0, np.roll(seg, -1), seg)
+
+
+def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Command:
+    """The speed command: block feeds, lowered to each junction's speed over the filter window
+    centred on it, and the pauses."""
     n = len(tp)
     s_start = geo.s_start_mm
     half = 0.5 * fir.length_s + 2 * fir.period_s  # the window, and a margin for sampling
@@ -335,35 +373,22 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter):
     z_lo = np.maximum(s_start[zone] - v[zone] * half, 0.0)
     z_hi = np.minimum(s_start[zone] + v[zone] * half, geo.total_mm)
     cuts = np.unique(np.concatenate([s_start, z_lo, z_hi]))
-    ds = np.diff(cuts)
     mid = 0.5 * (cuts[:-1] + cuts[1:])
     block = geo.block_at(mid)
     speed = p.feed_mm_s[block].copy()
     if zone.any():
         i_lo = np.searchsorted(cuts, z_lo)
         i_hi = np.searchsorted(cuts, z_hi)
-        speed = np.minimum(speed, _range_min(len(ds), i_lo, i_hi, v[zone]))
-    dur = ds / speed
-    # pauses sit at the cut where their junction is
+        speed = np.minimum(speed, _range_min(len(mid), i_lo, i_hi, v[zone]))
     at = np.searchsorted(cuts, s_start)
-    pause_at = np.zeros(len(cuts))
-    np.add.at(pause_at, at, p.pause_s)
-    # time knots: arrive at each cut, then wait its pause
-    arrive = np.concatenate([[0.0], np.cumsum(dur)]) + np.concatenate([[0.0], np.cumsum(pause_at)[:-1]])
-    leave = arrive + pause_at
-    t_knots = np.column_stack([arrive, leave]).ravel()
-    s_knots = np.repeat(cuts, 2)
-    # block of each time segment: moving segments, and pauses (a dwell's own block, else the
-    # block that ends at the stop)
+    pause = np.zeros(len(cuts))
+    np.add.at(pause, at, p.pause_s)
+    # a pause belongs to the dwell it is, else to the block that ends at the stop
     pause_block = np.full(len(cuts), -1)
     owner = np.where(tp.kind == MotionKind.DWELL, np.arange(n), np.maximum(np.arange(n) - 1, 0))
     has = p.pause_s[:n] > 0
     pause_block[at[:n][has]] = owner[has]
-    seg_t0 = t_knots[:-1]
-    seg_block = np.column_stack([np.where(pause_block >= 0, pause_block, -1),
-                                 np.append(block, block[-1] if len(block) else 0)]).ravel()[:-1]  # fmt: skip
-    seg_block = np.where(seg_block < 0, np.roll(seg_block, -1), seg_block)
-    return t_knots, s_knots, seg_t0, seg_block
+    return _Command(cuts, speed, block, pause, pause_block)
 
 
 #: Largest distance between an arc and the chords the command is interpolated on (mm).
@@ -383,8 +408,9 @@ def _refine_arcs(tp: Toolpath, geo: PathGeometry, t_knots, s_knots):
     # chord of angle dphi deviates r (1 - cos(dphi / 2)) ~ r dphi^2 / 8 from the arc
     dphi = np.sqrt(8.0 * ARC_CHORD_TOL_MM / r)
     with np.errstate(invalid="ignore"):
-        planar = np.abs(tp.sweep_rad[b]) * np.divide(ds, geo.lengths_mm[b], out=np.zeros_like(ds),
-                                                      where=geo.lengths_mm[b] > 0)  # fmt: skip
+        planar = np.abs(tp.sweep_rad[b]) * np.divide(
+            ds, geo.lengths_mm[b], out=np.zeros_like(ds), where=geo.lengths_mm[b] > 0
+        )
     need = np.divide(planar, dphi, out=np.zeros_like(planar), where=dphi > 0)
     parts = np.maximum(1, np.ceil(need).astype(np.int64))
     if parts.max() == 1:
@@ -394,6 +420,50 @@ def _refine_arcs(tp: Toolpath, geo: PathGeometry, t_knots, s_knots):
     t_new = np.append(t_knots[seg] + frac * np.diff(t_knots)[seg], t_knots[-1])
     s_new = np.append(s_knots[seg] + frac * ds[seg], s_knots[-1])
     return t_new, s_new
+
+
+#: Relative excess over an axis limit that counts as a violation (rounding of differences).
+LIMIT_RTOL = 1e-6
+#: Passes of slowing down where a filtered profile still exceeds an axis limit.
+MAX_SLOWDOWNS = 12
+#: Extra slow-down per pass, so that the passes converge.
+SLOWDOWN_MARGIN = 0.02
+
+
+def _interpolate(tp, geo, fir: FirFilter, t_knots, s_knots):
+    """Sample the command at the period and filter it; exact rest at both ends.
+
+    Returns the filtered positions (n, 3) and the filter lag in samples."""
+    ts = fir.period_s
+    t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
+    x_knots = geo.points(s_knots)
+    n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
+    t_cmd = np.arange(n_cmd) * ts
+    x = np.column_stack([np.interp(t_cmd, t_knots, x_knots[:, a]) for a in range(3)])
+    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
+    pos = fir.apply(x)
+    n1, n2 = fir.taps
+    lag = n1 + n2 - 2
+    # the filter's sums of equal values carry rounding: rest is exact at both ends
+    moving = np.flatnonzero(np.any(x != x[0], axis=1))
+    first = moving[0] if len(moving) else len(x)
+    pos[:first] = x[0]
+    still = np.flatnonzero(np.any(x != x[-1], axis=1))
+    pos[(still[-1] + 1 + lag) if len(still) else 0 :] = x[-1]
+    return pos, lag
+
+
+def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray:
+    """Largest ratio of axis velocity, acceleration and jerk to their limits, per sample.
+
+    Derivatives are backward differences of the positions, shape (n,)."""
+    ratio = np.zeros(len(pos))
+    d = pos
+    for order in range(3):
+        d = np.diff(d, axis=0) / ts
+        r = np.max(np.abs(d) / limits[order], axis=1)
+        ratio[order + 1 :] = np.maximum(ratio[order + 1 :], r)
+    return ratio
 
 
 def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
@@ -420,29 +490,37 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         z = np.zeros((1, 3))
         return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), ts)
     geo = PathGeometry(tp)
-    p = plan(tp, machine, fir)
-    t_knots, s_knots, seg_t0, seg_block = _command(tp, geo, p, fir)
-    t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
-    x_knots = geo.points(s_knots)
-    n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
-    t_cmd = np.arange(n_cmd) * ts
-    x = np.column_stack([np.interp(t_cmd, t_knots, x_knots[:, a]) for a in range(3)])
-    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
-    pos = fir.apply(x)
-    n1, n2 = fir.taps
-    lag = n1 + n2 - 2
-    # exact rest at both ends (the filter's sums of equal values carry rounding)
-    moving = np.flatnonzero(np.any(x != x[0], axis=1))
-    first = moving[0] if len(moving) else len(x)
-    pos[:first] = x[0]
-    still = np.flatnonzero(np.any(x != x[-1], axis=1))
-    pos[(still[-1] + 1 + lag) if len(still) else 0 :] = x[-1]
+    cmd = _command(tp, geo, plan(tp, machine, fir), fir)
+    limits = np.array(
+        [
+            machine.axis_max_velocity_mm_s,
+            machine.axis_max_acceleration_mm_s2,
+            machine.axis_max_jerk_mm_s3,
+        ]
+    )
+    scale = np.ones(len(cmd.speed))
+    for _ in range(MAX_SLOWDOWNS + 1):
+        t_knots, s_knots = cmd.knots(scale)
+        pos, lag = _interpolate(tp, geo, fir, t_knots, s_knots)
+        ratio = _limit_ratio(pos, ts, limits)
+        if ratio.max(initial=0.0) <= 1.0 + LIMIT_RTOL:
+            break
+        # slow the command over the windows that made the violating samples
+        bad = np.flatnonzero(ratio > 1.0 + LIMIT_RTOL)
+        t_lo = (bad - lag - 3) * ts
+        t_hi = bad * ts
+        move_t0 = t_knots[1::2][:-1]  # start times of the moving intervals
+        i_lo = np.searchsorted(move_t0, t_lo, side="right") - 1
+        i_hi = np.searchsorted(move_t0, t_hi, side="right")
+        factor = _range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
+        slow = factor < 1.0
+        scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
     vel = np.zeros_like(pos)
     vel[1:] = np.diff(pos, axis=0) / ts
     t = np.arange(len(pos)) * ts
     # block of each sample: the command's block at the centre of the filter window
-    first_sample = np.ceil(seg_t0 / ts - 1e-9).astype(np.int64) + lag // 2
+    first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
     counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
     counts[0] += min(first_sample[0], len(t))
-    block = np.repeat(seg_block, counts)
+    block = np.repeat(cmd.segment_blocks(), counts)
     return Motion(t, pos, vel, kept[block], ts)
