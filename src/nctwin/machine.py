@@ -55,6 +55,18 @@ class MachineProfile:
         Acc/dec time constant of rapids.
     rapid_bell_s : float
         Bell-shaped (S-curve) stage added to rapids; 0 for none.
+    rapid_type : {"linear", "nonlinear"}
+        Path of rapids: a straight line at the rapid feed (linear interpolation type), or each
+        axis on its own at the rapid feed (non-linear type, Lee et al. 2022, Fig. 3).
+    position_gain_per_s : tuple of 3 floats
+        Position-loop gain Kp of X, Y, Z (first-order loop: following error decays as
+        ``exp(-Kp t)``).
+    inposition_width_mm : tuple of 3 floats
+        In-position width of X, Y, Z: after a rapid, the next block waits until every axis's
+        following error is within it.
+    inposition_time_s : tuple of 3 floats
+        Measured in-position time of X, Y, Z after a rapid, used by analytic estimators
+        (Lee et al. 2022, Sec. 2.3); 0 where not measured.
     """
 
     name: str
@@ -71,11 +83,22 @@ class MachineProfile:
     cut_time_constant_s: float = 0.05
     rapid_time_constant_s: float = 0.1
     rapid_bell_s: float = 0.0
+    rapid_type: str = "linear"
+    position_gain_per_s: _XYZ = (30.0, 30.0, 30.0)
+    inposition_width_mm: _XYZ = (0.02, 0.02, 0.02)
+    inposition_time_s: _XYZ = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"name = {self.name!r} must be a non-empty string")
-        for f in ("axis_max_velocity_mm_s", "axis_max_acceleration_mm_s2", "axis_max_jerk_mm_s3"):
+        for f in (
+            "axis_max_velocity_mm_s",
+            "axis_max_acceleration_mm_s2",
+            "axis_max_jerk_mm_s3",
+            "position_gain_per_s",
+            "inposition_width_mm",
+            "inposition_time_s",
+        ):
             v = getattr(self, f)
             try:
                 v = tuple(float(x) for x in v)
@@ -84,8 +107,10 @@ class MachineProfile:
             if len(v) != 3:
                 raise ValueError(f"{f} = {v!r} must be three numbers (X, Y, Z)")
             allow_inf = f == "axis_max_jerk_mm_s3"
+            lo_closed = f == "inposition_time_s"
+            hi = 10.0 if lo_closed else math.inf
             for axis, x in zip("XYZ", v, strict=True):
-                _check(f"{f}[{axis}]", x, 0.0, math.inf, allow_inf=allow_inf)
+                _check(f"{f}[{axis}]", x, 0.0, hi, lo_closed=lo_closed, allow_inf=allow_inf)
             object.__setattr__(self, f, v)
         _check("rapid_feed_mm_s", self.rapid_feed_mm_s, 0.0, math.inf)
         _check("max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf)
@@ -94,6 +119,10 @@ class MachineProfile:
         for f in ("fir_t1_s", "fir_t2_s", "cut_time_constant_s", "rapid_time_constant_s"):
             _check(f, getattr(self, f), 0.0, 10.0, lo_closed=True, hi_closed=True)
         _check("rapid_bell_s", self.rapid_bell_s, 0.0, 10.0, lo_closed=True, hi_closed=True)
+        if self.rapid_type not in ("linear", "nonlinear"):
+            raise ValueError(
+                f"rapid_type = {self.rapid_type!r} is not allowed: allowed 'linear', 'nonlinear'"
+            )
 
     @classmethod
     def from_toml(cls, path: str | Path) -> MachineProfile:
