@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 from ..machine import MachineProfile
 from ..toolpath import Toolpath
+from .block_overlap import block_overlap
 from .cam import cam
 from .kernel import kernel
 from .result import Estimate
@@ -20,6 +21,7 @@ __all__ = ["METHODS", "Estimate", "cam", "estimate", "kernel"]
 METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
     "cam": cam,
     "kernel": kernel,
+    "block_overlap": block_overlap,
 }
 
 

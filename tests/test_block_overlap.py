@@ -1,0 +1,148 @@
+"""The analytic block-overlap estimator (Lee et al. 2022) against times computed by hand, and
+against the acc/dec kernel on random programs."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from test_accdec import MACHINE, _program, segment
+
+from nctwin import parse
+from nctwin.estimate import METHODS, estimate
+from nctwin.estimate.block_overlap import block_overlap, block_times
+from nctwin.kernel.accdec import simulate
+
+TI = MACHINE.period_s  # 1 ms
+AT, ATR, AS = 0.05, 0.15, 0.03
+FR = MACHINE.rapid_feed_mm_s
+INPOS = (0.025, 0.025, 0.12)
+
+
+def ceil_ti(t):
+    return math.ceil(round(t / TI, 6)) * TI
+
+
+def est(text, **kw):
+    return block_overlap(parse(text), MACHINE, inposition_s=INPOS, **kw)
+
+
+def test_one_normal_block():
+    # eq. 1-3: T = ceilTI(l / F) + AT; 10.0005 mm at 10 mm/s -> 1.00005 s -> 1.001 s
+    e = est("G1 X10.0005 F600")
+    assert e.cycle_time_s == pytest.approx(1.001 + AT, abs=1e-12)
+    assert e.cycle_time_s == pytest.approx(ceil_ti(10.0005 / 10.0) + AT, abs=1e-12)
+
+
+def test_one_short_cutting_block():
+    # eq. 4-5: 0.3 mm at 10 mm/s: Tb = AT, Ta = ceilTI(0.03 s); T = 80 ms
+    bt = block_times(parse("G1 X0.3 F600"), MACHINE)
+    assert bt["short"][0]
+    assert bt["T"][0] == pytest.approx(0.05 + 0.03, abs=1e-12)
+
+
+def test_one_short_rapid_without_bell():
+    # eq. 9-11: a = Fr / ATR; 2 mm: sqrt(2 / 1111.1) = 42.43 ms -> 43 ms; T = 2 Ta = 86 ms
+    m = dataclasses.replace(MACHINE, rapid_bell_s=0.0)
+    e = block_overlap(parse("G0 X2"), m, inposition=False)
+    a = FR / ATR
+    assert e.cycle_time_s == pytest.approx(2 * ceil_ti(math.sqrt(2 / a)), abs=1e-12)
+    assert e.cycle_time_s == pytest.approx(0.086, abs=1e-12)
+
+
+def test_short_rapid_with_bell_and_normal_rapids():
+    # eq. 15: T = 2 Ta + As; eq. 13: T = ceilTI(l / Fr) + ATR + As
+    assert est("G0 X2", inposition=False).cycle_time_s == pytest.approx(0.086 + AS, abs=1e-12)
+    assert est("G0 X100", inposition=False).cycle_time_s == pytest.approx(0.78, abs=1e-12)
+    # eq. 14, non-linear type: the longest axis travel (100 mm) instead of the 100.499 mm line
+    nonlinear = dataclasses.replace(MACHINE, rapid_type="nonlinear")
+    e = block_overlap(parse("G0 X100 Y10"), nonlinear, inposition=False)
+    assert e.cycle_time_s == pytest.approx(0.6 + ATR + AS, abs=1e-12)
+    assert est("G0 X100 Y10", inposition=False).cycle_time_s == pytest.approx(0.783, abs=1e-12)
+
+
+def test_two_overlapping_cutting_blocks():
+    # Fig. 6: T = Tb1 + Tb2 + AT
+    e = est("G1 X10 F600\nG1 Y10 F300")
+    assert e.cycle_time_s == pytest.approx(1.0 + 2.0 + AT, abs=1e-12)
+    np.testing.assert_allclose(e.block_times_s, [1.0, 2.0 + AT], atol=1e-12)
+    assert est("G1 X10 F600\nG1 Y10 F300", overlap=False).cycle_time_s == pytest.approx(
+        1.05 + 2.05, abs=1e-12
+    )
+
+
+def test_short_blocks_overlap_from_their_constant_velocity_part():
+    # Fig. 7: three 30 ms blocks: each next one starts after Ta = 30 ms; the chain ends AT later
+    e = est("G1 X0.3 F600\nG1 X0.6\nG1 X0.9")
+    assert e.cycle_time_s == pytest.approx(0.09 + AT, abs=1e-12)
+
+
+def test_no_overlap_across_rapids_and_dwells():
+    text = "G1 X10 F600\nG0 X20\nG1 X30\nG4 X0.5\nG1 X40"
+    e = est(text, inposition=False)
+    # every block stands alone; the 10 mm rapid is short: 2 ceil(sqrt(10 / a)) + As = 0.22 s
+    assert e.cycle_time_s == pytest.approx(1.05 + (0.19 + 0.03) + 1.05 + 0.5 + 1.05)
+    np.testing.assert_allclose(
+        est(text, overlap=False, inposition=False).block_times_s, e.block_times_s, atol=1e-12
+    )
+
+
+def test_inposition_of_the_slowest_moving_axis():
+    bare = est("G0 X100 Z-10", inposition=False).cycle_time_s
+    assert est("G0 X100 Z-10").cycle_time_s == pytest.approx(bare + 0.12, abs=1e-12)
+    bare = est("G0 X100 Y5", inposition=False).cycle_time_s
+    assert est("G0 X100 Y5").cycle_time_s == pytest.approx(bare + 0.025, abs=1e-12)
+    # the machine's own table is the default
+    m = dataclasses.replace(MACHINE, inposition_time_s=(0.0, 0.0, 0.2))
+    assert block_overlap(parse("G0 Z5"), m).cycle_time_s == pytest.approx(
+        block_overlap(parse("G0 Z5"), m, inposition=False).cycle_time_s + 0.2
+    )
+
+
+def test_registered_as_a_method():
+    assert "block_overlap" in METHODS
+    e = estimate(parse("G1 X10 F600"), MACHINE, "block_overlap")
+    assert e.method == "block_overlap"
+    assert e.cycle_time_s == pytest.approx(1.05)
+
+
+def test_bad_parameters_are_named():
+    with pytest.raises(ValueError, match=r"inposition_s = .* is out of range"):
+        block_overlap(parse("G0 X1"), MACHINE, inposition_s=(0.1, -0.1, 0.1))
+    bad = dataclasses.replace(MACHINE, cut_time_constant_s=0.0505)
+    with pytest.raises(ValueError, match=r"cut_time_constant_s = 0\.0505 is out of range"):
+        block_overlap(parse("G1 X1 F60"), bad)
+
+
+@given(
+    st.lists(st.one_of(segment, st.floats(0.0, 0.3)), min_size=1, max_size=8),
+    st.sampled_from([0.01, 0.05, 0.1]),
+)
+def test_estimator_agrees_with_kernel_within_one_period_per_block(items, at_s):
+    # random programs of lines, arcs and dwells (no rapids): the kernel rounds chains, the
+    # estimator every block, up to whole periods; nothing else differs
+    chunks, seg = [], []
+    for it in items:
+        if isinstance(it, float):
+            if seg:
+                chunks.append(_program(seg)[0])
+                seg = []
+            chunks.append(f"G4 X{it:.3f}")
+        else:
+            seg.append(it)
+    if seg:
+        chunks.append(_program(seg)[0])
+    # each chunk of segments starts from the origin in _program; join them with a G1 back there
+    text = "\nG1 X0 Y0 Z0 F600\n".join(chunks)
+    tp = parse(text)
+    m = dataclasses.replace(MACHINE, cut_time_constant_s=at_s)
+    measured = simulate(tp, m)
+    predicted = block_overlap(tp, m)
+    per_block = np.abs(measured.block_times_s - predicted.block_times_s)
+    assert per_block.max() <= TI * (1 + 1e-6)
+    assert abs(measured.cycle_time_s - predicted.cycle_time_s) <= len(tp) * TI * (1 + 1e-6)
+    assert predicted.cycle_time_s >= measured.cycle_time_s - 1e-9  # rounding up per block
