@@ -111,23 +111,25 @@ class FirFilter:
         return float((w * (k - mean) ** 2).sum())
 
     def apply(self, x: np.ndarray) -> np.ndarray:
-        """Filter sampled positions ``x`` (n, 3) that start and end at rest.
+        """Filter sampled positions ``x``, shape (3, n), axis-major, that start and end at rest.
 
-        Returns shape (n + n1 + n2 - 2, 3): the input is held at its first and last value
+        Returns shape (3, n + n1 + n2 - 2): the input is held at its first and last value
         outside its span. Each box is a difference of running sums, O(n); the sums run over
         positions relative to the start, which keeps their rounding below 1e-7 mm.
         """
-        out = x - x[0]
+        x0 = x[:, :1]
+        out = x - x0
         for n in self.taps:
             if n > 1:
-                held = np.empty((len(out) + 2 * n - 1, 3))
-                held[:n] = 0.0
-                held[n : n + len(out)] = out
-                held[n + len(out) :] = out[-1]
-                c = np.cumsum(held, axis=0)
-                out = c[n:] - c[:-n]
+                m = out.shape[1]
+                held = np.empty((3, m + 2 * n - 1))
+                held[:, :n] = 0.0
+                held[:, n : n + m] = out
+                held[:, n + m :] = out[:, -1:]
+                c = np.cumsum(held, axis=1)
+                out = c[:, n:] - c[:, :-n]
                 out /= n
-        return out + x[0]
+        return out + x0
 
 
 def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
@@ -433,36 +435,46 @@ SLOWDOWN_MARGIN = 0.02
 def _interpolate(tp, geo, fir: FirFilter, t_knots, s_knots):
     """Sample the command at the period and filter it; exact rest at both ends.
 
-    Returns the filtered positions (n, 3) and the filter lag in samples."""
+    Returns the filtered positions, shape (3, n) axis-major, and the filter lag in samples."""
     ts = fir.period_s
     t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
     x_knots = geo.points(s_knots)
     n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
     t_cmd = np.arange(n_cmd) * ts
-    x = np.column_stack([np.interp(t_cmd, t_knots, x_knots[:, a]) for a in range(3)])
-    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
+    x = np.empty((3, n_cmd))
+    for a in range(3):
+        x[a] = np.interp(t_cmd, t_knots, x_knots[:, a])
+    x[:, 0], x[:, -1] = tp.start_mm[0], tp.end_mm[-1]
     pos = fir.apply(x)
     n1, n2 = fir.taps
     lag = n1 + n2 - 2
     # the filter's sums of equal values carry rounding: rest is exact at both ends
-    moving = np.flatnonzero(np.any(x != x[0], axis=1))
-    first = moving[0] if len(moving) else len(x)
-    pos[:first] = x[0]
-    still = np.flatnonzero(np.any(x != x[-1], axis=1))
-    pos[(still[-1] + 1 + lag) if len(still) else 0 :] = x[-1]
+    moving = np.flatnonzero(np.any(x != x[:, :1], axis=0))
+    pos[:, : moving[0] if len(moving) else n_cmd] = x[:, :1]
+    still = np.flatnonzero(np.any(x != x[:, -1:], axis=0))
+    pos[:, (still[-1] + 1 + lag) if len(still) else 0 :] = x[:, -1:]
     return pos, lag
 
 
-def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray:
+def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray | None:
     """Largest ratio of axis velocity, acceleration and jerk to their limits, per sample.
 
-    Derivatives are backward differences of the positions, shape (n,)."""
-    ratio = np.zeros(len(pos))
+    ``pos`` is (3, n); derivatives are backward differences. Returns shape (n,), or None when
+    no sample exceeds a limit (the common case, checked first on the maxima)."""
+    derivs = []
     d = pos
-    for order in range(3):
-        d = np.diff(d, axis=0) / ts
-        r = np.max(np.abs(d) / limits[order], axis=1)
-        ratio[order + 1 :] = np.maximum(ratio[order + 1 :], r)
+    for _ in range(3):
+        d = np.diff(d, axis=1) / ts
+        derivs.append(d)
+    peaks = np.array([np.abs(d).max(axis=1, initial=0.0) for d in derivs])  # (order, axis)
+    if (peaks <= limits * (1.0 + LIMIT_RTOL)).all():
+        return None
+    ratio = np.zeros(pos.shape[1])
+    for order, d in enumerate(derivs):
+        for a in range(3):
+            if peaks[order, a] > limits[order, a] * (1.0 + LIMIT_RTOL):
+                r = np.abs(d[a]) / limits[order, a]
+                np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
     return ratio
 
 
@@ -503,7 +515,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         t_knots, s_knots = cmd.knots(scale)
         pos, lag = _interpolate(tp, geo, fir, t_knots, s_knots)
         ratio = _limit_ratio(pos, ts, limits)
-        if ratio.max(initial=0.0) <= 1.0 + LIMIT_RTOL:
+        if ratio is None:
             break
         # slow the command over the windows that made the violating samples
         bad = np.flatnonzero(ratio > 1.0 + LIMIT_RTOL)
@@ -516,11 +528,11 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         slow = factor < 1.0
         scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
     vel = np.zeros_like(pos)
-    vel[1:] = np.diff(pos, axis=0) / ts
-    t = np.arange(len(pos)) * ts
+    vel[:, 1:] = np.diff(pos, axis=1) / ts
+    t = np.arange(pos.shape[1]) * ts
     # block of each sample: the command's block at the centre of the filter window
     first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
     counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
     counts[0] += min(first_sample[0], len(t))
     block = np.repeat(cmd.segment_blocks(), counts)
-    return Motion(t, pos, vel, kept[block], ts)
+    return Motion(t, pos.T, vel.T, kept[block], ts)

@@ -1,0 +1,202 @@
+"""The FIR kernel against physics derived by hand (see nctwin.kernel.fir)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from nctwin import parse
+from nctwin.features import block_targets
+from nctwin.kernel import fir
+from nctwin.machine import MachineProfile
+
+MACHINE = MachineProfile(
+    name="fir-test",
+    description="round numbers, limits far from the tests' feeds",
+    axis_max_velocity_mm_s=(1000.0, 1000.0, 1000.0),
+    axis_max_acceleration_mm_s2=(1e5, 1e5, 1e5),
+    axis_max_jerk_mm_s3=(1e9, 1e9, 1e9),
+    rapid_feed_mm_s=500.0,
+    max_feed_mm_s=1000.0,
+    period_s=0.001,
+    blend_tol_mm=0.05,
+    fir_t1_s=0.05,
+    fir_t2_s=0.01,
+)
+FILTER = fir.FirFilter.of(MACHINE)
+
+
+def _corner_distance(pos: np.ndarray, corner) -> float:
+    """Distance from a point to the polyline through the samples."""
+    a, b = pos[:-1], pos[1:]
+    ab = b - a
+    t = np.einsum("ij,ij->i", corner - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+    closest = a + np.clip(t, 0, 1)[:, None] * ab
+    return float(np.linalg.norm(closest - corner, axis=1).min())
+
+
+def test_straight_line_takes_l_over_f_plus_t1_plus_t2():
+    feed, length = 80.0, 120.0
+    motion = fir.run(parse(f"G1 X{length} F{feed * 60}"), MACHINE)
+    expected = length / feed + MACHINE.fir_t1_s + MACHINE.fir_t2_s
+    assert motion.cycle_time_s == pytest.approx(expected, abs=MACHINE.period_s)
+    np.testing.assert_array_equal(motion.pos_mm[0], [0, 0, 0])
+    np.testing.assert_array_equal(motion.pos_mm[-1], [length, 0, 0])
+    assert motion.speed_mm_s.max() == pytest.approx(feed, rel=1e-9)
+    # acceleration F / T1 and jerk F / (T1 T2), within the rounding of differences
+    acc = np.abs(motion.acc_mm_s2[:, 0]).max()
+    jerk = np.abs(motion.jerk_mm_s3[:, 0]).max()
+    assert acc <= feed / MACHINE.fir_t1_s * (1 + 1e-6)
+    assert acc == pytest.approx(feed / (MACHINE.fir_t1_s + MACHINE.period_s), rel=1e-6)
+    assert jerk <= feed / (MACHINE.fir_t1_s * MACHINE.fir_t2_s) * (1 + 1e-6)
+
+
+def test_filter_taps_span_the_time_constants():
+    n1, n2 = FILTER.taps
+    assert (n1, n2) == (51, 11)
+    assert FILTER.weights.sum() == pytest.approx(1.0)
+    assert FILTER.length_s == pytest.approx(MACHINE.fir_t1_s + MACHINE.fir_t2_s)
+
+
+def test_corner_without_reduction_matches_the_closed_form():
+    # tolerance far above the deviation: the corner is passed at the programmed feed
+    feed = 40.0
+    tp = parse(f"G64 P5 G1 X50 F{feed * 60}\nY50")
+    assert fir.plan(tp, MACHINE).junction_mm_s[1] == pytest.approx(feed)
+    d = _corner_distance(fir.run(tp, MACHINE).pos_mm, np.array([50.0, 0, 0]))
+    # the sampled boxes average n = T/Ts + 1 samples: their continuous twins are n Ts long
+    n1, n2 = FILTER.taps
+    ts = MACHINE.period_s
+    closed = fir.corner_deviation_mm(feed, math.pi / 2, n1 * ts, n2 * ts)
+    assert d == pytest.approx(closed, rel=2e-3)
+    assert closed == pytest.approx(
+        feed * math.sin(math.pi / 4) * (3 * (n1 * ts) ** 2 + (n2 * ts) ** 2) / (12 * n1 * ts)
+    )
+
+
+@pytest.mark.parametrize("angle_deg", [45.0, 90.0, 135.0])
+def test_reduced_corner_is_within_tolerance_at_the_highest_feed(angle_deg):
+    tol, feed = 0.05, 100.0
+    a = math.radians(angle_deg)
+    corner = np.array([50.0, 0.0, 0.0])
+    end = corner + 50.0 * np.array([math.cos(a), math.sin(a), 0.0])
+    program = f"G1 X50 F{feed * 60}\nX{end[0]:.9f} Y{end[1]:.9f}"
+    tp = parse(f"G64 P{tol}\n{program}")
+    v = fir.plan(tp, MACHINE).junction_mm_s[1]
+    assert 0 < v < feed  # reduced
+    assert _corner_distance(fir.run(tp, MACHINE).pos_mm, corner) <= tol
+    # one percent faster through the same corner breaks the tolerance
+    faster = parse(f"G64 P5\nG1 X50 F{v * 1.01 * 60}\nX{end[0]:.9f} Y{end[1]:.9f}")
+    assert _corner_distance(fir.run(faster, MACHINE).pos_mm, corner) > tol
+
+
+def test_exact_stop_and_dwell():
+    tp = parse("G61 G1 X10 F600\nY10\nG4 P0.5\nX0")
+    motion = fir.run(tp, MACHINE)
+    stops = np.flatnonzero(motion.speed_mm_s == 0)
+    # the tool stands still at the corner (G61) and for the dwell
+    at_corner = np.linalg.norm(motion.pos_mm - [10, 0, 0], axis=1) < 1e-9
+    assert at_corner.any() and (motion.speed_mm_s[at_corner][1:] == 0).all()
+    dwell = np.linalg.norm(motion.pos_mm - [10, 10, 0], axis=1) < 1e-9
+    assert dwell.sum() * MACHINE.period_s >= 0.5
+    assert len(stops) > 0
+    targets = block_targets(motion, tp)
+    assert targets.time_s[2] == pytest.approx(0.5, abs=2 * MACHINE.period_s)
+    assert targets.cycle_time_s == pytest.approx(motion.cycle_time_s)
+
+
+def test_short_segments_on_a_circle_keep_the_feed_high():
+    # 1000 segments of 0.1 mm on a circle of radius 20 mm: blended globally
+    r, n, feed = 20.0, 1000, 80.0
+    phi = np.arange(1, n + 1) * (0.1 / r)
+    pts = np.column_stack([r * np.cos(phi), r * np.sin(phi)])
+    program = f"G64 P0.05\nG0 X{r} Y0\nF{feed * 60}\n" + "\n".join(
+        f"G1 X{x:.6f} Y{y:.6f}" for x, y in pts
+    )
+    tp = parse(program)
+    motion = fir.run(tp, MACHINE)
+    middle = (motion.block > 200) & (motion.block < 800)
+    assert np.median(motion.speed_mm_s[middle]) >= 0.95 * feed
+    assert motion.speed_mm_s[middle].min() >= 0.9 * feed
+
+
+def test_zigzag_dips_at_every_corner():
+    # 1000 segments of 2 mm turning by 120 degrees each, alternately left and right
+    n, feed, seg = 1000, 80.0, 2.0
+    heading = np.where(np.arange(n) % 2 == 0, math.radians(60), math.radians(-60))
+    pts = np.cumsum(seg * np.column_stack([np.cos(heading), np.sin(heading)]), axis=0)
+    tp = parse(
+        "G64 P0.05\nF%g\n" % (feed * 60) + "\n".join(f"G1 X{x:.6f} Y{y:.6f}" for x, y in pts)
+    )
+    plan = fir.plan(tp, MACHINE)
+    assert (plan.junction_mm_s[1:n] < 0.5 * feed).all()
+    motion = fir.run(tp, MACHINE)
+    targets = block_targets(motion, tp)
+    at_corners = motion.speed_mm_s[targets.junction_sample[1:n]]
+    assert (at_corners < 0.5 * feed).all()
+
+
+def test_kernel_cycle_time_exceeds_cam():
+    tp = parse("G1 X10 F6000\nY10\nX0\nY0")
+    motion = fir.run(tp, MACHINE)
+    assert motion.cycle_time_s > 40.0 / 100.0 + FILTER.length_s
+
+
+def test_bad_filter_constants_are_named():
+    slow = dataclasses.replace(MACHINE, fir_t1_s=0.0, fir_t2_s=0.0)
+    with pytest.raises(ValueError, match=r"fir_t1_s = 0.0 is out of range for the FIR kernel"):
+        fir.run(parse("G1 X1 F60"), slow)
+
+
+# ------------------------------------------------------------------------------ properties
+LIMITED = dataclasses.replace(
+    MACHINE,
+    axis_max_velocity_mm_s=(150.0, 120.0, 60.0),
+    axis_max_acceleration_mm_s2=(2000.0, 1500.0, 1000.0),
+    axis_max_jerk_mm_s3=(2e5, 1.5e5, 1e5),
+    rapid_feed_mm_s=300.0,
+    max_feed_mm_s=200.0,
+)
+
+_xyz = st.tuples(*(st.floats(-30, 30) for _ in range(3)))
+
+
+@st.composite
+def programs(draw) -> str:
+    lines = [f"G64 P{draw(st.sampled_from([0.005, 0.05, 0.5, 3.0]))}"]
+    scale = draw(st.sampled_from([0.02, 1.0, 10.0]))
+    for _ in range(draw(st.integers(1, 30))):
+        x, y, z = (v * scale / 10 for v in draw(_xyz))
+        code = draw(st.sampled_from(["G1", "G1", "G0", "G4"]))
+        if code == "G4":
+            lines.append(f"G4 P{draw(st.floats(0, 0.2)):.3f}")
+        else:
+            lines.append(f"{code} X{x:.4f} Y{y:.4f} Z{z / 3:.4f} F{draw(st.integers(60, 15000))}")
+    return "\n".join(lines)
+
+
+@settings(max_examples=60, deadline=None)
+@given(programs())
+def test_kernel_invariants(program):
+    tp = parse(program)
+    motion = fir.run(tp, LIMITED)
+    np.testing.assert_array_equal(motion.pos_mm[-1], tp.end_mm[-1])
+    np.testing.assert_array_equal(motion.pos_mm[0], tp.start_mm[0])
+    assert np.isfinite(motion.pos_mm).all()
+    # never faster than the fastest commanded feed (rapids at the rapid feed)
+    top = max(LIMITED.rapid_feed_mm_s, np.nanmax(np.append(tp.feed_mm_s, 0)))
+    assert motion.speed_mm_s.max() <= top * (1 + 1e-9)
+    # no axis beyond its velocity, acceleration or jerk limit
+    for derivative, limit in (
+        (motion.vel_mm_s, LIMITED.axis_max_velocity_mm_s),
+        (motion.acc_mm_s2, LIMITED.axis_max_acceleration_mm_s2),
+        (motion.jerk_mm_s3, LIMITED.axis_max_jerk_mm_s3),
+    ):
+        assert (np.abs(derivative).max(axis=0) <= np.asarray(limit) * (1 + 1e-5)).all()
+    # the per-block times add up to the cycle time (Chien et al. eq. 3)
+    assert block_targets(motion, tp).cycle_time_s == pytest.approx(motion.cycle_time_s)
