@@ -1,0 +1,29 @@
+"""Speed of Lee et al. 2022's analytic estimate and of the acc/dec kernel on the shipped
+ISO 10791-7-style test piece (over 30 minutes of cycle time, about 2000 blocks).
+
+Targets: the analytic estimate in under 20 ms (the paper: under 1 s; at least 50x faster), the
+kernel simulation in under 2 s.
+"""
+
+from __future__ import annotations
+
+from _common import best_time_s, record
+
+from nctwin import parse_file
+from nctwin.estimate.block_overlap import block_overlap
+from nctwin.kernel.accdec import simulate
+from nctwin.machine import load_machine
+from nctwin.programs.iso10791 import shipped_test_piece_path
+
+
+def main() -> None:
+    tp = parse_file(shipped_test_piece_path())
+    machine = load_machine("fanuc_0i_testbed")
+    t = best_time_s(lambda: block_overlap(tp, machine))
+    record("block_overlap_analytic_s", round(t, 6), "s", "< 0.02")
+    t = best_time_s(lambda: simulate(tp, machine), repeat=3, warmup=1)
+    record("accdec_kernel_s", round(t, 4), "s", "< 2")
+
+
+if __name__ == "__main__":
+    main()
