@@ -73,3 +73,22 @@ def test_installed_entry_point_runs(program):
 def test_machines_lists_profiles(capsys):
     assert main(["machines"]) == 0
     assert "generic_mill" in capsys.readouterr().out
+
+
+def test_simulate_writes_plot_and_csv(program, tmp_path, capsys):
+    png, csv = tmp_path / "feed.png", tmp_path / "motion.csv"
+    assert main(["simulate", str(program), "--plot", str(png), "--csv", str(csv), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["cycle_time_s"] > 0 and data["samples"] > 100
+    assert png.stat().st_size > 1000
+    header = csv.read_text().splitlines()[0]
+    assert header.startswith("t_s,x_mm,y_mm,z_mm")
+
+
+def test_kernel_estimate_is_slower_than_cam(program, capsys):
+    assert main(["estimate", str(program), "--json"]) == 0
+    cam = json.loads(capsys.readouterr().out)["cycle_time_s"]
+    assert main(["estimate", str(program), "--json", "--method", "kernel"]) == 0
+    kernel = json.loads(capsys.readouterr().out)
+    assert kernel["method"] == "kernel"
+    assert kernel["cycle_time_s"] > cam

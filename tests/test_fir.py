@@ -200,3 +200,20 @@ def test_kernel_invariants(program):
         assert (np.abs(derivative).max(axis=0) <= np.asarray(limit) * (1 + 1e-5)).all()
     # the per-block times add up to the cycle time (Chien et al. eq. 3)
     assert block_targets(motion, tp).cycle_time_s == pytest.approx(motion.cycle_time_s)
+
+
+def test_arc_feed_is_limited_by_centripetal_acceleration():
+    # r = 5 mm, A = 2000 mm/s^2 on X and Y: at most sqrt(A r) = 100 mm/s on the arc
+    tight = dataclasses.replace(
+        MACHINE, axis_max_acceleration_mm_s2=(2000.0, 2000.0, 2000.0), blend_tol_mm=10.0
+    )
+    tp = parse("G0 X5 Y0\nG3 X5 Y0 I-5 J0 F30000")
+    v_arc = math.sqrt(2000.0 * 5.0)
+    assert fir.plan(tp, tight).feed_mm_s[1] == pytest.approx(v_arc)
+    motion = fir.run(tp, tight)
+    on_arc = motion.block == 1
+    assert motion.speed_mm_s[on_arc].max() <= v_arc * (1 + 1e-9)
+    # the tool stays on the circle within the filter's shrinkage
+    r = np.hypot(motion.pos_mm[on_arc, 0], motion.pos_mm[on_arc, 1])
+    shrink = v_arc**2 * FILTER.variance_s2 / (2 * 5.0)
+    assert np.abs(r - 5.0).max() <= 2 * shrink + 1e-6

@@ -1,0 +1,48 @@
+"""FIR kernel throughput: the 5000-line pocket (about 220 s of motion at 1 ms) and the
+10,000-line ``contour.ngc``.
+
+Targets: at least 10 million output samples per second; the pocket in under 0.3 s. The
+throughput is end to end (planning included); ``kernel_filter_samples_per_s`` times the O(n)
+filter stage alone.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from _common import SHARED_PROGRAMS, best_time_s, record
+
+from nctwin import parse, parse_file
+from nctwin.kernel import fir
+from nctwin.machine import load_machine
+from nctwin.programs.pocket import pocket_program
+
+
+def main() -> None:
+    machine = load_machine("paper1_sim")
+    pocket = parse(pocket_program(tol_mm=0.3))
+    samples = len(fir.run(pocket, machine))
+    t = best_time_s(lambda: fir.run(pocket, machine), repeat=5, warmup=1)
+    record("kernel_pocket5000_s", round(t, 4), "s", "< 0.3")
+    x = fir.run(pocket, machine).pos_mm.T.copy()  # (3, n) samples to filter
+    flt = fir.FirFilter.of(machine)
+    tf = best_time_s(lambda: flt.apply(x), repeat=5, warmup=1)
+    record("kernel_filter_samples_per_s", round(x.shape[1] / tf), "samples/s", ">= 1e7")
+    total_samples, total_time = samples, t
+    contour = SHARED_PROGRAMS / "contour.ngc"
+    if contour.exists():
+        tp = parse_file(contour)
+        n = len(fir.run(tp, machine))
+        tc = best_time_s(lambda: fir.run(tp, machine), repeat=5, warmup=1)
+        record("kernel_contour_samples_per_s", round(n / tc), "samples/s", ">= 1e7")
+        total_samples += n
+        total_time += tc
+    else:
+        print(f"kernel: {contour} not found, skipped", file=sys.stderr)
+    record("kernel_samples_per_s", round(total_samples / total_time), "samples/s", ">= 1e7")
+    record("kernel_pocket5000_lines", len(pocket), "G-lines", "~5000")
+    record("kernel_pocket5000_motion_s", samples * machine.period_s, "s", "~220")
+
+
+if __name__ == "__main__":
+    main()
