@@ -71,36 +71,54 @@ def _format_duration(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:04.1f}"
 
 
-def _estimate(args: argparse.Namespace) -> int:
+def _load(args: argparse.Namespace):
+    """The machine and the parsed program named on the command line."""
     machine = load_machine(args.machine)
     tp = parse_file(args.program, units=args.units, dwell_p_unit=args.dwell_p_unit)
-    result = estimate(tp, machine, args.method)
-    summary = {"program": args.program, **result.summary()}
-    if args.json:
+    return machine, tp
+
+
+def _report(summary: dict, rows: list[tuple[str, str]], extra: list[str], as_json: bool) -> int:
+    """Print ``summary`` as JSON, or ``rows`` as an aligned table followed by ``extra`` lines."""
+    if as_json:
         print(json.dumps(summary, indent=2))
         return 0
-    print(f"program      {args.program}")
-    print(f"machine      {machine.name}")
-    print(f"method       {result.method}")
-    print(
-        f"cycle time   {summary['cycle_time_s']:.3f} s  ({_format_duration(result.cycle_time_s)})"
-    )
-    print(f"path length  {summary['length_mm']:.3f} mm")
-    print(f"blocks       {summary['blocks']}")
-    print(f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}")
-    for kind, row in summary["by_kind"].items():
-        if row["blocks"]:
-            print(
-                f"  {kind:<8} {row['blocks']:>8d} {row['length_mm']:>12.3f} {row['time_s']:>10.3f}"
-            )
+    for key, value in rows:
+        print(f"{key:<12} {value}")
+    for line in extra:
+        print(line)
     return 0
+
+
+def _common_rows(summary: dict, machine_note: str = "") -> list[tuple[str, str]]:
+    t = summary["cycle_time_s"]
+    return [
+        ("program", summary["program"]),
+        ("machine", summary["machine"] + machine_note),
+        ("cycle time", f"{t:.3f} s  ({_format_duration(t)})"),
+        ("path length", f"{summary['length_mm']:.3f} mm"),
+        ("blocks", str(summary["blocks"])),
+    ]
+
+
+def _estimate(args: argparse.Namespace) -> int:
+    machine, tp = _load(args)
+    result = estimate(tp, machine, args.method)
+    summary = {"program": args.program, **result.summary()}
+    rows = _common_rows(summary)
+    rows.insert(2, ("method", result.method))
+    table = [f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}"] + [
+        f"  {kind:<8} {r['blocks']:>8d} {r['length_mm']:>12.3f} {r['time_s']:>10.3f}"
+        for kind, r in summary["by_kind"].items()
+        if r["blocks"]
+    ]
+    return _report(summary, rows, table, args.json)
 
 
 def _simulate(args: argparse.Namespace) -> int:
     from .kernel import fir
 
-    machine = load_machine(args.machine)
-    tp = parse_file(args.program, units=args.units, dwell_p_unit=args.dwell_p_unit)
+    machine, tp = _load(args)
     motion = fir.run(tp, machine)
     summary = {
         "program": args.program,
@@ -125,20 +143,11 @@ def _simulate(args: argparse.Namespace) -> int:
         ax = feed_profile(motion, tp, machine, title=f"{args.program} on {machine.name}")
         ax.figure.savefig(args.plot, dpi=120)
         summary["plot"] = args.plot
-    if args.json:
-        print(json.dumps(summary, indent=2))
-        return 0
-    print(f"program      {args.program}")
-    print(f"machine      {machine.name} (FIR kernel)")
-    print(f"cycle time   {motion.cycle_time_s:.3f} s  ({_format_duration(motion.cycle_time_s)})")
-    print(f"path length  {tp.length_mm:.3f} mm")
-    print(f"blocks       {len(tp)}")
-    print(f"samples      {len(motion)} at {motion.period_s * 1e3:g} ms")
-    print(f"max speed    {summary['max_speed_mm_s']:.3f} mm/s")
-    for key in ("csv", "plot"):
-        if key in summary:
-            print(f"wrote        {summary[key]}")
-    return 0
+    rows = _common_rows(summary, " (FIR kernel)")
+    rows.append(("samples", f"{len(motion)} at {motion.period_s * 1e3:g} ms"))
+    rows.append(("max speed", f"{summary['max_speed_mm_s']:.3f} mm/s"))
+    rows += [("wrote", summary[key]) for key in ("csv", "plot") if key in summary]
+    return _report(summary, rows, [], args.json)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

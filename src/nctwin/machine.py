@@ -15,7 +15,13 @@ from pathlib import Path
 
 from .paths import data_dir
 
-__all__ = ["DEFAULT_MACHINE", "MachineProfile", "available_machines", "load_machine"]
+__all__ = [
+    "DEFAULT_MACHINE",
+    "MachineProfile",
+    "available_machines",
+    "load_machine",
+    "whole_periods",
+]
 
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
@@ -171,6 +177,23 @@ def _check(
         interval = f"{'[' if lo_closed else '('}{lo:g}, {hi:g}{']' if hi_closed else ')'}"
         extra = " or inf" if allow_inf else ""
         raise ValueError(f"{name} = {value!r} is out of range: allowed {interval}{extra}")
+
+
+def whole_periods(name: str, value_s: float, period_s: float) -> int:
+    """A time setting as a whole number of interpolation periods.
+
+    Raises
+    ------
+    ValueError
+        Naming the setting, its value and the allowed values, if it is not a whole multiple.
+    """
+    k = round(value_s / period_s)
+    if not math.isclose(k * period_s, value_s, rel_tol=1e-9, abs_tol=1e-12):
+        raise ValueError(
+            f"{name} = {value_s!r} is out of range: allowed whole multiples of "
+            f"period_s = {period_s!r}"
+        )
+    return k
 
 
 def machines_dir() -> Path:

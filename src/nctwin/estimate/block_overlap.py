@@ -48,7 +48,7 @@ import math
 
 import numpy as np
 
-from ..machine import MachineProfile
+from ..machine import MachineProfile, whole_periods
 from ..toolpath import MotionKind, Toolpath
 from .result import Estimate
 
@@ -60,15 +60,6 @@ _CUT = (MotionKind.LINEAR, MotionKind.ARC_CW, MotionKind.ARC_CCW)
 def _ceil_ti(t_s: np.ndarray, period_s: float) -> np.ndarray:
     """:math:`\\lceil t \\rceil_{T_I}` (eq. 2), forgiving 1e-9 period of round-off."""
     return np.ceil(np.asarray(t_s, dtype=float) / period_s - 1e-9) * period_s
-
-
-def _multiple(name: str, value_s: float, period_s: float) -> None:
-    k = round(value_s / period_s)
-    if not math.isclose(k * period_s, value_s, rel_tol=1e-9, abs_tol=1e-12):
-        raise ValueError(
-            f"{name} = {value_s!r} is out of range: allowed whole multiples of "
-            f"period_s = {period_s!r}"
-        )
 
 
 def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.ndarray]:
@@ -94,9 +85,9 @@ def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.nda
         machine.rapid_time_constant_s,
         machine.rapid_bell_s,
     )
-    _multiple("cut_time_constant_s", at, ti)
-    _multiple("rapid_time_constant_s", atr, ti)
-    _multiple("rapid_bell_s", bell, ti)
+    whole_periods("cut_time_constant_s", at, ti)
+    whole_periods("rapid_time_constant_s", atr, ti)
+    whole_periods("rapid_bell_s", bell, ti)
     kind = toolpath.kind
     lengths = toolpath.lengths_mm
     cut = np.isin(kind, _CUT)

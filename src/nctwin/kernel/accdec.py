@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from ..machine import MachineProfile
+from ..machine import MachineProfile, whole_periods
 from ..motion import Motion
 from ..toolpath import PLANE_AXES, MotionKind, Toolpath
 
@@ -96,17 +96,6 @@ class AccDecRun:
         """Measured cycle time: from cycle start until the last block is done (and, after a
         rapid, in position)."""
         return self.motion.cycle_time_s
-
-
-def _periods(name: str, value_s: float, period_s: float) -> int:
-    """``value_s`` as a whole number of periods; ValueError if it is not one."""
-    k = round(value_s / period_s)
-    if not math.isclose(k * period_s, value_s, rel_tol=1e-9, abs_tol=1e-12):
-        raise ValueError(
-            f"{name} = {value_s!r} is out of range: allowed whole multiples of "
-            f"period_s = {period_s!r}"
-        )
-    return int(k)
 
 
 def _ceil_periods(t_s: np.ndarray | float, period_s: float) -> np.ndarray:
@@ -281,9 +270,9 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
         If a time constant is not a whole number of periods, or a cutting block has no feed.
     """
     ti = machine.period_s
-    k_at = _periods("cut_time_constant_s", machine.cut_time_constant_s, ti)
-    k_r = _periods("rapid_time_constant_s", machine.rapid_time_constant_s, ti)
-    k_s = _periods("rapid_bell_s", machine.rapid_bell_s, ti)
+    k_at = whole_periods("cut_time_constant_s", machine.cut_time_constant_s, ti)
+    k_r = whole_periods("rapid_time_constant_s", machine.rapid_time_constant_s, ti)
+    k_s = whole_periods("rapid_bell_s", machine.rapid_bell_s, ti)
     kind = toolpath.kind
     cut = np.isin(kind, _CUT)
     feed = np.minimum(toolpath.feed_mm_s, machine.max_feed_mm_s)
