@@ -283,7 +283,15 @@ def plan(tp: Toolpath, machine: MachineProfile, fir: FirFilter | None = None) ->
         # largest V with e(V) <= tol: secant steps on log e over log V (e ~ V for a local
         # corner, ~ V^2 for a smooth curve) alternating with bisection of the bracket [lo, hi]
         lo, e_lo = np.zeros_like(hi), np.zeros_like(hi)
-        active = np.flatnonzero(e_hi > tol_j)
+        # an isolated corner between two lines longer than half a window: the deviation is
+        # exactly proportional to the speed, so one step solves it
+        reach = hi * (0.5 * fir.length_s + fir.period_s)
+        line = (tp.kind[jj - 1] <= MotionKind.LINEAR) & (tp.kind[jj] <= MotionKind.LINEAR)
+        alone = line & (tp.lengths_mm[jj - 1] > reach) & (tp.lengths_mm[jj] > reach)
+        alone &= e_hi > tol_j
+        lo[alone] = hi[alone] * tol_j[alone] / e_hi[alone]
+        e_lo[alone] = tol_j[alone]
+        active = np.flatnonzero((e_hi > tol_j) & ~alone)
         for it in range(60):
             if not len(active):
                 break
