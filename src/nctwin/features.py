@@ -19,7 +19,7 @@ import numpy as np
 from .motion import Motion
 from .toolpath import MotionKind, Toolpath
 
-__all__ = ["BlockTargets", "block_targets"]
+__all__ = ["CHIEN2023_FEATURES", "BlockTargets", "block_targets", "chien2023_features"]
 
 
 @dataclass(frozen=True)
@@ -99,4 +99,44 @@ def block_targets(motion: Motion, toolpath: Toolpath, *, search_samples: int = 2
         junction_sample=junction,
         length_mm=np.diff(travelled[junction]),
         time_s=np.diff(junction) * motion.period_s,
+    )
+
+
+#: Column names of :func:`chien2023_features`.
+CHIEN2023_FEATURES = ("feed_mm_s", "length_mm", "theta_start_rad", "theta_end_rad", "tol_mm")
+
+
+def chien2023_features(toolpath: Toolpath, machine_tol_mm: float) -> np.ndarray:
+    r"""Input features of the BiLSTM, one row per G-line (Chien et al. 2023, Sec. 2.2, Fig. 4).
+
+    Row ``k`` is :math:`(F, l_k, \theta_k, \theta_{k+1}, \varepsilon)`: commanded feed, nominal
+    length, corner angle at the start and at the end of the G-line, and blending tolerance (the
+    program's ``G64 P`` where it sets one, else ``machine_tol_mm``). The tool starts and ends the
+    program at rest, which the kernel treats like a reversal, so the start angle of the first
+    G-line and the end angle of the last are :math:`\pi`.
+
+    Parameters
+    ----------
+    toolpath : Toolpath
+        Linear feed moves (the programs of the paper).
+    machine_tol_mm : float
+        The machine's default blending tolerance.
+
+    Returns
+    -------
+    ndarray, shape (N, 5)
+        Columns :data:`CHIEN2023_FEATURES`.
+    """
+    n = len(toolpath)
+    theta = np.append(toolpath.corner_angles_rad, np.pi)
+    if n:
+        theta[0] = np.pi
+    return np.column_stack(
+        [
+            toolpath.feed_mm_s,
+            toolpath.lengths_mm,
+            theta[:n],
+            theta[1:],
+            toolpath.effective_tolerance_mm(machine_tol_mm),
+        ]
     )

@@ -1,0 +1,298 @@
+r"""Training and test programs of Chien, Sencer & Ward (2023, Sec. 3.1 and 4.1).
+
+Two families of *training* programs (Sec. 3.1, Fig. 6), planar, linear G-lines only:
+
+* **Global** programs trigger global blending: every G-line is short, :math:`l_k \in (0, 1)` mm
+  (here :data:`GLOBAL_LENGTH_MM`), and the feed direction turns at every junction. The path is a
+  chain of *sections*; in each, the direction turns by a section-wide rate (a curve of random
+  radius, discretised as CAM systems do) plus a random jitter, and with probability
+  :data:`SHARP_SHARE` a junction turns by an angle drawn uniformly in :math:`(-\pi, \pi)`, so the
+  corner angles :math:`\theta_k` of the data set cover :math:`(0, \pi)` (the paper's "random
+  :math:`\theta_k \in (0, 2\pi)`" direction changes: a turn by :math:`\phi` and by
+  :math:`2\pi - \phi` are the same corner).
+* **Mixed** programs (75 % local, 25 % global G-lines): global sections as above alternate with
+  runs of *local* G-lines of length :math:`l_k \in (0, 1000)` mm and random direction changes in
+  :math:`(-\pi, \pi)`. The lengths are log-uniform in :data:`LOCAL_LENGTH_MM` rather than
+  uniform, so that lines of a few millimetres (where the corners of both ends interact) are as
+  common as lines of hundreds: a uniform draw would make 99 % of them longer than 10 mm. Half
+  the local runs leave the curve before them tangentially, as lines meet arcs in real parts.
+
+Two *test* contours (Table 1, "toolpath I" and "toolpath II", Fig. 7): closed-free chains of
+straight lines, sharp zig-zags (local blends of short lines), and smooth curves discretised into
+short chords (global blends), in a fixed random order. Toolpath II has about 6 times the
+sections of I, so it takes about 6-7 times as long, as in Table 1.
+
+Every generator takes a :class:`numpy.random.Generator` (or a seed) and returns G-code text
+(mm, absolute, ``G64 P<eps>`` for the blending tolerance), which :func:`nctwin.gcode.parse`
+reads; nothing uses a global random state.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "GLOBAL_LENGTH_MM",
+    "LOCAL_LENGTH_MM",
+    "SHARP_SHARE",
+    "ProgramSpec",
+    "contour_program",
+    "global_program",
+    "mixed_program",
+    "program_text",
+    "training_specs",
+]
+
+#: Length range of globally blended G-lines (mm): the paper's (0, 1) mm without lines so short
+#: that four decimals would round them to nothing.
+GLOBAL_LENGTH_MM = (0.05, 1.0)
+#: Length range of locally blended G-lines (mm), drawn log-uniform (paper: (0, 1000) mm).
+LOCAL_LENGTH_MM = (0.5, 1000.0)
+#: Share of junctions in global sections that turn by a random angle in (-pi, pi).
+SHARP_SHARE = 0.05
+#: Radius range of the curves of global sections (mm), drawn log-uniform.
+CURVE_RADIUS_MM = (1.0, 200.0)
+#: G-lines per section (global sections and local runs of mixed programs).
+SECTION_LINES = (10, 80)
+
+
+def _rng(seed: int | np.random.Generator) -> np.random.Generator:
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+
+
+def _log_uniform(rng: np.random.Generator, lo: float, hi: float, size=None):
+    return np.exp(rng.uniform(math.log(lo), math.log(hi), size))
+
+
+def _global_turns(rng: np.random.Generator, lengths_mm: np.ndarray) -> np.ndarray:
+    """Direction change at the start of each short G-line of a global section (rad), shape (n,).
+
+    A curve of log-uniform radius ``R`` turns by ``l_k / R`` per line, with a jitter of up to
+    the same size; a share :data:`SHARP_SHARE` of the junctions turns by a uniform random angle.
+    """
+    n = len(lengths_mm)
+    radius = _log_uniform(rng, *CURVE_RADIUS_MM) * rng.choice([-1.0, 1.0])
+    jitter = rng.uniform(0.0, 1.0) if rng.random() < 0.5 else 0.0
+    turns = lengths_mm / radius * (1.0 + jitter * rng.uniform(-1.0, 1.0, n))
+    sharp = rng.random(n) < SHARP_SHARE
+    turns[sharp] = rng.uniform(-math.pi, math.pi, int(sharp.sum()))
+    return turns
+
+
+def _polyline(lengths_mm: np.ndarray, turns_rad: np.ndarray) -> np.ndarray:
+    """End points (n, 2) of a chain of lines from the origin with the given lengths and turns."""
+    heading = np.cumsum(turns_rad)
+    steps = lengths_mm[:, None] * np.column_stack([np.cos(heading), np.sin(heading)])
+    return np.cumsum(steps, axis=0)
+
+
+def program_text(points_mm: np.ndarray, *, feed_mm_s: float, tol_mm: float, title: str) -> str:
+    """G-code of a planar chain of G1 lines from the origin through ``points_mm`` (n, 2).
+
+    Coordinates are written with four decimals; a point that rounds onto its predecessor is
+    dropped, so the program has no zero-length line.
+    """
+    rounded = np.round(np.vstack([[0.0, 0.0], points_mm]), 4)
+    keep = np.concatenate([[True], np.any(np.diff(rounded, axis=0) != 0, axis=1)])
+    rounded = rounded[keep][1:]
+    lines = [f"({title})", "G21 G90 G17", f"G64 P{tol_mm:g}", f"G1 F{feed_mm_s * 60:g}"]
+    lines += [f"X{x:.4f} Y{y:.4f}" for x, y in rounded]
+    lines.append("M30")
+    return "\n".join(lines) + "\n"
+
+
+def _global_section(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Short lines on a curve: in half the sections of random lengths, in the other half of one
+    length (a CAM system's constant chord)."""
+    if rng.random() < 0.5:
+        lengths = rng.uniform(*GLOBAL_LENGTH_MM, n)
+    else:
+        lengths = np.full(n, rng.uniform(*GLOBAL_LENGTH_MM))
+    return lengths, _global_turns(rng, lengths)
+
+
+def _local_section(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Long lines with random direction changes; in half the runs the first line leaves the
+    section before it tangentially (a line meeting a curve, as in pockets and contours)."""
+    turns = rng.uniform(-math.pi, math.pi, n)
+    if rng.random() < 0.5:
+        turns[0] = 0.0
+    return _log_uniform(rng, *LOCAL_LENGTH_MM, n), turns
+
+
+def _sections(rng: np.random.Generator, n_lines: int, local_share: float):
+    """Lengths and turns of ``n_lines`` G-lines: sections of 10-80 lines, local with
+    probability ``local_share`` (by G-line count, on average)."""
+    lengths, turns, count = [], [], 0
+    while count < n_lines:
+        n = min(int(rng.integers(*SECTION_LINES, endpoint=True)), n_lines - count)
+        local = rng.random() < local_share
+        ln, tn = (_local_section if local else _global_section)(rng, n)
+        lengths.append(ln)
+        turns.append(tn)
+        count += n
+    return np.concatenate(lengths), np.concatenate(turns)
+
+
+def global_program(
+    seed: int | np.random.Generator, *, n_lines: int = 1000, feed_mm_s: float, tol_mm: float
+) -> str:
+    """A "global blending" training program (Sec. 3.1, Fig. 6a): short lines on random curves.
+
+    Parameters
+    ----------
+    seed : int or numpy.random.Generator
+    n_lines : int
+        Number of G1 lines.
+    feed_mm_s, tol_mm : float
+        Programmed feed and ``G64 P`` blending tolerance.
+
+    Returns
+    -------
+    str
+        G-code text.
+    """
+    rng = _rng(seed)
+    lengths, turns = _sections(rng, n_lines, local_share=0.0)
+    return program_text(
+        _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
+        title=f"nctwin global training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
+    )  # fmt: skip
+
+
+def mixed_program(
+    seed: int | np.random.Generator,
+    *,
+    n_lines: int = 1000,
+    feed_mm_s: float,
+    tol_mm: float,
+    local_share: float = 0.75,
+) -> str:
+    """A "mixed" training program (Sec. 3.1, Fig. 6b): 75 % local, 25 % global G-lines.
+
+    Parameters
+    ----------
+    seed : int or numpy.random.Generator
+    n_lines : int
+        Number of G1 lines.
+    feed_mm_s, tol_mm : float
+        Programmed feed and ``G64 P`` blending tolerance.
+    local_share : float
+        Expected share of G-lines in local sections.
+
+    Returns
+    -------
+    str
+        G-code text.
+    """
+    if not 0.0 <= local_share <= 1.0:
+        raise ValueError(f"local_share = {local_share!r} is out of range: allowed [0, 1]")
+    rng = _rng(seed)
+    lengths, turns = _sections(rng, n_lines, local_share=local_share)
+    return program_text(
+        _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
+        title=f"nctwin mixed training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ProgramSpec:
+    """One training program: its family, size, feed, tolerance and seed."""
+
+    family: str
+    n_lines: int
+    feed_mm_s: float
+    tol_mm: float
+    seed: int
+
+    def text(self) -> str:
+        """The program's G-code."""
+        make = {"global": global_program, "mixed": mixed_program}[self.family]
+        return make(self.seed, n_lines=self.n_lines, feed_mm_s=self.feed_mm_s, tol_mm=self.tol_mm)
+
+
+def training_specs(
+    seed: int,
+    *,
+    n_programs: int,
+    n_lines: int,
+    feed_range_mm_s: tuple[float, float],
+    tol_range_mm: tuple[float, float],
+    mixed_share: float = 0.5,
+) -> list[ProgramSpec]:
+    """The training set: ``n_programs`` programs, a share ``mixed_share`` of them mixed.
+
+    Feeds and tolerances are uniform in their ranges (rounded to 1 mm/s and 0.005 mm, as a
+    programmer would type them); each program gets its own seed from ``seed``.
+    """
+    if n_programs < 1 or n_lines < 2:
+        raise ValueError(f"n_programs = {n_programs}, n_lines = {n_lines}: need >= 1 and >= 2")
+    rng = np.random.default_rng(seed)
+    n_mixed = round(mixed_share * n_programs)
+    families = ["mixed"] * n_mixed + ["global"] * (n_programs - n_mixed)
+    feeds = np.round(rng.uniform(*feed_range_mm_s, n_programs))
+    tols = np.round(rng.uniform(*tol_range_mm, n_programs) / 0.005) * 0.005
+    seeds = rng.integers(0, 2**63 - 1, n_programs)
+    return [
+        ProgramSpec(f, n_lines, float(v), round(float(e), 4), int(s))
+        for f, v, e, s in zip(families, feeds, tols, seeds, strict=True)
+    ]
+
+
+# ------------------------------------------------------------------------------------------------
+# Test contours (Table 1, toolpaths I and II)
+
+#: Sections of test toolpaths I and II (II takes 6-7 times as long as I, as in Table 1).
+TEST_SECTIONS = {"I": 42, "II": 250}
+#: Seeds of the test contours (fixed: the contours are part of the chapter, like the paper's).
+TEST_SEEDS = {"I": 1001, "II": 1002}
+
+
+def _test_section(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """One section of a test contour: a straight, a sharp zig-zag or a smooth curve."""
+    kind = rng.choice(["straight", "zigzag", "curve"], p=[0.25, 0.35, 0.4])
+    if kind == "straight":
+        n = int(rng.integers(1, 4))
+        return rng.uniform(15.0, 60.0, n), rng.uniform(-0.5, 0.5, n) * math.pi
+    if kind == "zigzag":
+        n = int(rng.integers(6, 20))
+        legs = rng.uniform(1.0, 8.0) * rng.uniform(0.7, 1.3, n)
+        angle = rng.uniform(0.4, 0.85) * math.pi
+        return legs, angle * (-1.0) ** np.arange(n)
+    radius = _log_uniform(rng, 2.0, 60.0)
+    sweep = rng.uniform(0.5, 1.5) * math.pi * rng.choice([-1.0, 1.0])
+    chord = rng.uniform(0.3, 1.0)
+    n = max(3, math.ceil(abs(sweep) * radius / chord))
+    lengths = np.full(n, abs(sweep) * radius / n)
+    turns = np.full(n, sweep / n)
+    turns[0] = rng.uniform(-0.25, 0.25) * math.pi
+    return lengths, turns
+
+
+def contour_program(name: str, *, feed_mm_s: float, tol_mm: float) -> str:
+    """Test toolpath I or II of Table 1: a complex planar contour with sharp and smooth sections.
+
+    Parameters
+    ----------
+    name : {"I", "II"}
+    feed_mm_s, tol_mm : float
+        Programmed feed and ``G64 P`` blending tolerance.
+
+    Returns
+    -------
+    str
+        G-code text.
+    """
+    if name not in TEST_SECTIONS:
+        raise ValueError(f"name = {name!r} is unknown: allowed {', '.join(TEST_SECTIONS)}")
+    rng = np.random.default_rng(TEST_SEEDS[name])
+    parts = [_test_section(rng) for _ in range(TEST_SECTIONS[name])]
+    lengths = np.concatenate([p[0] for p in parts])
+    turns = np.concatenate([p[1] for p in parts])
+    return program_text(
+        _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
+        title=f"nctwin test toolpath {name}: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
+    )  # fmt: skip
