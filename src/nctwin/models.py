@@ -1,0 +1,116 @@
+"""Small torch sequence models, each described by a frozen config stored with its checkpoint.
+
+One module, one config (after nanoGPT): :class:`ModelConfig` says which network and how large;
+:func:`build` makes it. All models map a sequence of per-G-line features, shape
+(batch, lines, n_inputs), to per-G-line outputs, shape (batch, lines, n_outputs).
+
+* ``"bilstm"`` -- Chien, Sencer & Ward (2023, Sec. 4.1, Fig. 4): one bidirectional LSTM layer
+  (tanh, ``hidden`` units per direction) and a fully connected linear output. The backward
+  direction reads the G-lines that follow, as the NC kernel's look-ahead does.
+* ``"lstm"`` -- the same, forward direction only (no look-ahead): an ablation.
+* ``"mlp"`` -- a per-line multilayer perceptron (tanh) that sees one G-line's features only: an
+  ablation without any sequence context.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import torch
+from torch import nn
+
+__all__ = ["KINDS", "ModelConfig", "SequenceModel", "build"]
+
+#: Model kinds :func:`build` knows.
+KINDS = ("bilstm", "lstm", "mlp")
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """Architecture of a sequence model.
+
+    Parameters
+    ----------
+    kind : {"bilstm", "lstm", "mlp"}
+    n_inputs : int
+        Features per G-line.
+    n_outputs : int
+        Outputs per G-line.
+    hidden : int
+        LSTM units per direction, or width of each MLP hidden layer.
+    mlp_layers : int
+        Hidden layers of the MLP (ignored by the LSTMs).
+    """
+
+    kind: str = "bilstm"
+    n_inputs: int = 5
+    n_outputs: int = 1
+    hidden: int = 10
+    mlp_layers: int = 2
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"kind = {self.kind!r} is unknown: allowed {', '.join(KINDS)}")
+        for name in ("n_inputs", "n_outputs", "hidden", "mlp_layers"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
+
+    def to_dict(self) -> dict:
+        """Plain dict (what the checkpoint stores)."""
+        return asdict(self)
+
+
+class SequenceModel(nn.Module):
+    """A per-G-line regressor: LSTM layer (or MLP) and a linear output.
+
+    ``forward(x)`` takes x of shape (batch, lines, n_inputs) and returns (batch, lines,
+    n_outputs).
+    """
+
+    def __init__(self, config: ModelConfig) -> None:
+        super().__init__()
+        self.config = config
+        c = config
+        if c.kind == "mlp":
+            layers: list[nn.Module] = []
+            width = c.n_inputs
+            for _ in range(c.mlp_layers):
+                layers += [nn.Linear(width, c.hidden), nn.Tanh()]
+                width = c.hidden
+            self.body: nn.Module = nn.Sequential(*layers)
+            self.head = nn.Linear(width, c.n_outputs)
+        else:
+            bidirectional = c.kind == "bilstm"
+            self.body = nn.LSTM(c.n_inputs, c.hidden, batch_first=True, bidirectional=bidirectional)
+            self.head = nn.Linear(c.hidden * (2 if bidirectional else 1), c.n_outputs)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        h = self.body(x)
+        if isinstance(h, tuple):  # LSTM: (output, (h_n, c_n))
+            h = h[0]
+        return self.head(h)
+
+
+def build(config: ModelConfig, *, generator: torch.Generator | None = None) -> SequenceModel:
+    """Make the model of ``config`` with weights drawn from ``generator`` (reproducible).
+
+    The default initialisations of :mod:`torch.nn` draw from the global generator; the weights
+    are redrawn here with the same distributions (uniform in ``(-1/sqrt(fan), 1/sqrt(fan))``, the
+    PyTorch default for LSTM and Linear layers) from the given generator instead.
+    """
+    model = SequenceModel(config)
+    with torch.no_grad():
+        for name, p in model.named_parameters():
+            if isinstance(model.body, nn.LSTM) and name.startswith("body."):
+                fan = config.hidden
+            else:
+                fan = p.shape[-1] if p.ndim > 1 else _fan_in(model, name)
+            bound = fan**-0.5
+            p.copy_(torch.empty_like(p).uniform_(-bound, bound, generator=generator))
+    return model
+
+
+def _fan_in(model: nn.Module, bias_name: str) -> int:
+    """Fan-in of the layer a bias belongs to (the width of its weight's last axis)."""
+    weight = dict(model.named_parameters())[bias_name.rsplit(".", 1)[0] + ".weight"]
+    return int(weight.shape[-1])

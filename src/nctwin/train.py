@@ -1,0 +1,421 @@
+"""The one training loop every chapter uses: seeded, with a progress bar, early stopping and a
+checkpoint in ``data/cache/``.
+
+Conventions
+-----------
+Data
+    A training set is a list of programs; program ``i`` has inputs ``xs[i]`` of shape
+    (N_i, n_inputs) and targets ``ys[i]`` of shape (N_i, n_outputs), one row per G-line. NaN
+    targets are left out of the loss (a G-line whose target is undefined).
+Split
+    Whole programs are held out for validation (a share ``val_share``, at least one), so that
+    validation G-lines never share a program with training G-lines.
+Scaling
+    Inputs (optionally the logarithm of some columns) and targets are standardised with the mean
+    and standard deviation of the *training* programs only; the validation programs and every
+    later input are scaled with those statistics (:class:`Scaler`).
+Windows
+    Sequence models train on windows of ``window_lines`` consecutive G-lines, cut at a random
+    offset each epoch, so that one batch runs many programs in parallel. Prediction runs
+    overlapping windows of the same length and keeps the middle half of each (a quarter of the
+    window of context on either side), which is also what makes it fast (:meth:`Trained.predict`).
+Determinism
+    The initial weights, the window offsets and the batch order are drawn from generators seeded
+    with ``seed``; :func:`fit` runs with ``torch.use_deterministic_algorithms(True)`` and one
+    intra-op thread (``torch.set_num_threads(1)``: summation order, hence rounding, depends on the
+    thread count), and restores both settings when it returns. The same data and configs give
+    the same weights, bit for bit, on one machine.
+Checkpoints
+    ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config and
+    the training config, written atomically (temporary file, then ``os.replace``) and read with
+    ``torch.load(..., weights_only=True)``: the file holds tensors and plain Python values only,
+    never pickled objects.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+import os
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from . import paths
+from .models import ModelConfig, SequenceModel, build
+
+__all__ = ["Scaler", "TrainConfig", "Trained", "fit", "load_checkpoint"]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """How to train.
+
+    Parameters
+    ----------
+    seed : int
+    max_epochs : int
+    patience : int
+        Stop after this many epochs without a lower validation loss; the best weights are kept.
+    batch_size : int
+        Windows per optimiser step.
+    window_lines : int
+        G-lines per training window (and per prediction window).
+    learning_rate : float
+        Adam step size.
+    val_share : float
+        Share of programs held out for validation.
+    loss : {"rmse", "mse"}
+        Root mean square error (Chien et al. 2023, Sec. 3) or mean square error, of the scaled
+        targets.
+    log_inputs : tuple of int
+        Input columns standardised as logarithms (lengths spanning decades).
+    """
+
+    seed: int = 0
+    max_epochs: int = 200
+    patience: int = 20
+    batch_size: int = 32
+    window_lines: int = 128
+    learning_rate: float = 5e-3
+    val_share: float = 0.15
+    loss: str = "rmse"
+    log_inputs: tuple[int, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        if self.loss not in ("rmse", "mse"):
+            raise ValueError(f"loss = {self.loss!r} is unknown: allowed rmse, mse")
+        if not 0.0 < self.val_share < 1.0:
+            raise ValueError(f"val_share = {self.val_share!r} is out of range: allowed (0, 1)")
+        for name in ("max_epochs", "patience", "batch_size", "window_lines"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["log_inputs"] = list(self.log_inputs)
+        return d
+
+
+@dataclass(frozen=True)
+class Scaler:
+    """Standardisation ``(g(x) - mean) / std`` per column, ``g = log`` on ``log_columns``.
+
+    Parameters
+    ----------
+    mean, std : ndarray, shape (n_columns,)
+    log_columns : tuple of int
+    """
+
+    mean: np.ndarray
+    std: np.ndarray
+    log_columns: tuple[int, ...] = ()
+
+    @classmethod
+    def fit(cls, arrays: Sequence[np.ndarray], log_columns: Sequence[int] = ()) -> Scaler:
+        """Statistics of the rows of ``arrays`` (each (N_i, n_columns)), NaNs ignored; a
+        constant column gets ``std = 1``."""
+        x = _log(np.concatenate(arrays), tuple(log_columns))
+        mean = np.nanmean(x, axis=0)
+        std = np.nanstd(x, axis=0)
+        return cls(mean, np.where(std > 0, std, 1.0), tuple(log_columns))
+
+    def transform(self, x: np.ndarray) -> np.ndarray:
+        """Scaled copy of ``x`` (N, n_columns), float32."""
+        return ((_log(x, self.log_columns) - self.mean) / self.std).astype(np.float32)
+
+    def inverse(self, z: np.ndarray) -> np.ndarray:
+        """Undo :meth:`transform` (float64)."""
+        x = np.asarray(z, dtype=np.float64) * self.std + self.mean
+        if self.log_columns:
+            x[:, list(self.log_columns)] = np.exp(x[:, list(self.log_columns)])
+        return x
+
+
+def _log(x: np.ndarray, columns: tuple[int, ...]) -> np.ndarray:
+    x = np.array(x, dtype=np.float64)
+    if columns:
+        x[:, list(columns)] = np.log(x[:, list(columns)])
+    return x
+
+
+@dataclass(frozen=True, eq=False)
+class Trained:
+    """A trained model with its scalers and training record.
+
+    Parameters
+    ----------
+    model : SequenceModel
+        In evaluation mode, best validation weights.
+    x_scaler, y_scaler : Scaler
+    train_config : TrainConfig
+    history : dict
+        ``{"train": [...], "val": [...]}`` losses per epoch (scaled targets).
+    best_epoch : int
+        Epoch (from 1) of the kept weights.
+    train_seconds : float
+        Wall time of the training run (as recorded when the checkpoint was made).
+    path : Path
+        The checkpoint.
+    """
+
+    model: SequenceModel
+    x_scaler: Scaler
+    y_scaler: Scaler
+    train_config: TrainConfig
+    history: dict
+    best_epoch: int
+    train_seconds: float
+    path: Path
+
+    def predict(self, x: np.ndarray) -> np.ndarray:
+        """Outputs for one program, shape (N, n_outputs), from inputs (N, n_inputs).
+
+        Runs overlapping windows of ``window_lines`` in one batch and keeps the middle half of
+        each (see the module docstring)."""
+        z = torch.from_numpy(self.x_scaler.transform(x))
+        n, w = len(z), self.train_config.window_lines
+        with torch.no_grad():
+            if n <= w:
+                out = self.model(z[None])[0].numpy()
+            else:
+                core = max(w // 2, 1)
+                a = np.arange(0, n, core)
+                s = np.clip(a - (w - core) // 2, 0, n - w)
+                idx = s[:, None] + np.arange(w)[None, :]
+                y = self.model(z[torch.from_numpy(idx)]).numpy()  # (windows, w, out)
+                out = np.empty((n, y.shape[-1]), dtype=y.dtype)
+                for i, (ai, si) in enumerate(zip(a, s, strict=True)):
+                    b = min(ai + core, n)
+                    out[ai:b] = y[i, ai - si : b - si]
+        return self.y_scaler.inverse(out)
+
+
+def data_hash(xs: Sequence[np.ndarray], ys: Sequence[np.ndarray]) -> str:
+    """SHA-256 of the training data (shapes and bytes of every array, in order)."""
+    h = hashlib.sha256()
+    for a in (*xs, *ys):
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _checkpoint_path(name: str, key: str) -> Path:
+    return paths.cache_dir() / "models" / f"{name}-{key[:16]}.pt"
+
+
+def _split(n_programs: int, cfg: TrainConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Training and validation program indices (seeded permutation)."""
+    if n_programs < 2:
+        raise ValueError(f"need at least 2 programs (training and validation), got {n_programs}")
+    order = np.random.default_rng([cfg.seed, 1]).permutation(n_programs)
+    n_val = min(max(1, round(cfg.val_share * n_programs)), n_programs - 1)
+    return np.sort(order[n_val:]), np.sort(order[:n_val])
+
+
+def _windows(lengths: Sequence[int], w: int, rng: np.random.Generator | None):
+    """(program, start, valid) of windows covering every program; a random offset per program
+    (none when ``rng`` is None). Programs shorter than ``w`` give one window, padded."""
+    out = []
+    for p, n in enumerate(lengths):
+        if n <= w:
+            out.append((p, 0, n))
+            continue
+        offset = int(rng.integers(0, w)) if rng is not None else 0
+        starts = np.arange(offset, n - w + 1, w)
+        if offset > 0:
+            starts = np.concatenate([[0], starts])
+        if starts[-1] + w < n:
+            starts = np.append(starts, n - w)
+        out += [(p, int(s), w) for s in starts]
+    return out
+
+
+def _batch(zx, zy, windows, w):
+    """Stack windows into (B, w, n) inputs, targets and a mask of valid, finite targets."""
+    b = len(windows)
+    x = np.zeros((b, w, zx[0].shape[1]), dtype=np.float32)
+    y = np.zeros((b, w, zy[0].shape[1]), dtype=np.float32)
+    m = np.zeros((b, w, zy[0].shape[1]), dtype=bool)
+    for i, (p, s, v) in enumerate(windows):
+        x[i, :v] = zx[p][s : s + v]
+        t = zy[p][s : s + v]
+        m[i, :v] = np.isfinite(t)
+        y[i, :v] = np.nan_to_num(t)
+    return torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(m)
+
+
+def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) -> torch.Tensor:
+    mse = ((pred - y) ** 2 * mask).sum() / mask.sum().clamp(min=1)
+    return mse.sqrt() if kind == "rmse" else mse
+
+
+def fit(
+    model_config: ModelConfig,
+    train_config: TrainConfig,
+    xs: Sequence[np.ndarray],
+    ys: Sequence[np.ndarray],
+    *,
+    name: str = "model",
+    cache: bool = True,
+    progress: bool = True,
+) -> Trained:
+    """Train ``model_config`` on programs ``xs``/``ys``, or load the cached checkpoint.
+
+    Parameters
+    ----------
+    model_config : ModelConfig
+    train_config : TrainConfig
+    xs, ys : sequences of ndarray, shapes (N_i, n_inputs) and (N_i, n_outputs)
+        One entry per program.
+    name : str
+        Prefix of the checkpoint file.
+    cache : bool
+        Load a checkpoint with the same data and configs if present; save the result.
+    progress : bool
+        Show a tqdm bar over epochs.
+
+    Returns
+    -------
+    Trained
+    """
+    if len(xs) != len(ys):
+        raise ValueError(f"xs and ys differ in length: {len(xs)} and {len(ys)}")
+    key_src = json.dumps(
+        {"data": data_hash(xs, ys), "model": model_config.to_dict(),
+         "train": train_config.to_dict()},
+        sort_keys=True,
+    )  # fmt: skip
+    path = _checkpoint_path(name, hashlib.sha256(key_src.encode()).hexdigest())
+    if cache and path.exists():
+        return load_checkpoint(path)
+
+    threads = torch.get_num_threads()
+    deterministic = torch.are_deterministic_algorithms_enabled()
+    torch.set_num_threads(1)
+    torch.use_deterministic_algorithms(True)
+    try:
+        trained = _train(model_config, train_config, xs, ys, path, progress)
+    finally:
+        torch.set_num_threads(threads)
+        torch.use_deterministic_algorithms(deterministic)
+    if cache:
+        save_checkpoint(trained)
+    return trained
+
+
+def _train(model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool) -> Trained:
+    t0 = time.perf_counter()
+    train_idx, val_idx = _split(len(xs), cfg)
+    x_scaler = Scaler.fit([xs[i] for i in train_idx], cfg.log_inputs)
+    y_scaler = Scaler.fit([ys[i] for i in train_idx])
+    zx = [x_scaler.transform(x) for x in xs]
+    zy = [y_scaler.transform(y) for y in ys]
+    w = cfg.window_lines
+    generator = torch.Generator().manual_seed(cfg.seed)
+    rng = np.random.default_rng([cfg.seed, 2])
+    model = build(model_config, generator=generator)
+    optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+    val_windows = _windows([len(zx[i]) for i in val_idx], w, None)
+    vx, vy, vm = _batch([zx[i] for i in val_idx], [zy[i] for i in val_idx], val_windows, w)
+    tx = [zx[i] for i in train_idx]
+    ty = [zy[i] for i in train_idx]
+    history: dict[str, list[float]] = {"train": [], "val": []}
+    best, best_state, best_epoch, stale = math.inf, None, 0, 0
+    bar = tqdm(
+        range(1, cfg.max_epochs + 1),
+        desc=path.stem,
+        disable=not progress,
+        leave=False,
+        mininterval=5.0,
+    )
+    for epoch in bar:
+        model.train()
+        windows = _windows([len(x) for x in tx], w, rng)
+        order = rng.permutation(len(windows))
+        total, count = 0.0, 0
+        for b in range(0, len(order), cfg.batch_size):
+            bx, by, bm = _batch(tx, ty, [windows[i] for i in order[b : b + cfg.batch_size]], w)
+            loss = _loss(model(bx), by, bm, cfg.loss)
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+            total += float(loss.detach()) * len(bx)
+            count += len(bx)
+        model.eval()
+        with torch.no_grad():
+            val = float(_loss(model(vx), vy, vm, cfg.loss))
+        history["train"].append(total / count)
+        history["val"].append(val)
+        bar.set_postfix(train=f"{total / count:.4f}", val=f"{val:.4f}")
+        if val < best:
+            best, best_state, best_epoch, stale = val, copy.deepcopy(model.state_dict()), epoch, 0
+        else:
+            stale += 1
+            if stale >= cfg.patience:
+                break
+    bar.close()
+    model.load_state_dict(best_state)
+    model.eval()
+    return Trained(
+        model, x_scaler, y_scaler, cfg, history, best_epoch, time.perf_counter() - t0, path
+    )
+
+
+def _scaler_dict(s: Scaler) -> dict:
+    return {"mean": torch.from_numpy(s.mean), "std": torch.from_numpy(s.std),
+            "log_columns": list(s.log_columns)}  # fmt: skip
+
+
+def _scaler_of(d: dict) -> Scaler:
+    return Scaler(d["mean"].numpy(), d["std"].numpy(), tuple(d["log_columns"]))
+
+
+def save_checkpoint(trained: Trained) -> Path:
+    """Write ``trained`` to its path atomically (temporary file in the folder, then rename)."""
+    path = trained.path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    payload = {
+        "model_config": trained.model.config.to_dict(),
+        "train_config": trained.train_config.to_dict(),
+        "state_dict": trained.model.state_dict(),
+        "x_scaler": _scaler_dict(trained.x_scaler),
+        "y_scaler": _scaler_dict(trained.y_scaler),
+        "history": trained.history,
+        "best_epoch": trained.best_epoch,
+        "train_seconds": trained.train_seconds,
+    }
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        torch.save(payload, tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def load_checkpoint(path: str | os.PathLike) -> Trained:
+    """Read a checkpoint written by :func:`save_checkpoint` (``weights_only=True``)."""
+    path = Path(path)
+    d = torch.load(path, map_location="cpu", weights_only=True)
+    model_config = ModelConfig(**d["model_config"])
+    tc = dict(d["train_config"])
+    tc["log_inputs"] = tuple(tc["log_inputs"])
+    model = SequenceModel(model_config)
+    model.load_state_dict(d["state_dict"])
+    model.eval()
+    return Trained(
+        model, _scaler_of(d["x_scaler"]), _scaler_of(d["y_scaler"]), TrainConfig(**tc),
+        d["history"], int(d["best_epoch"]), float(d["train_seconds"]), path,
+    )  # fmt: skip

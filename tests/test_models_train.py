@@ -1,0 +1,115 @@
+"""Models and the shared training loop: seeded, early stopping, checkpoints, scaling."""
+
+import numpy as np
+import pytest
+import torch
+
+from nctwin import paths
+from nctwin.models import ModelConfig, build
+from nctwin.train import Scaler, TrainConfig, _split, fit, load_checkpoint
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path, monkeypatch):
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path))
+    assert paths.cache_dir() == tmp_path / "cache"
+
+
+def _data(n_programs=6, n=90, seed=0):
+    """Target: a running sum over neighbours (needs context) plus a per-line term."""
+    rng = np.random.default_rng(seed)
+    xs, ys = [], []
+    for _ in range(n_programs):
+        x = rng.uniform(0.5, 2.0, (n, 2))
+        y = np.column_stack([x[:, 0] + np.convolve(x[:, 1], np.ones(5) / 5, mode="same")])
+        xs.append(x)
+        ys.append(y)
+    return xs, ys
+
+
+CFG = TrainConfig(seed=1, max_epochs=8, patience=3, batch_size=4, window_lines=32)
+
+
+@pytest.mark.parametrize("kind", ["bilstm", "lstm", "mlp"])
+def test_shapes(kind):
+    model = build(ModelConfig(kind, n_inputs=2, n_outputs=3, hidden=4))
+    assert model(torch.zeros(2, 7, 2)).shape == (2, 7, 3)
+
+
+def test_build_is_seeded():
+    a = build(ModelConfig(), generator=torch.Generator().manual_seed(5)).state_dict()
+    b = build(ModelConfig(), generator=torch.Generator().manual_seed(5)).state_dict()
+    c = build(ModelConfig(), generator=torch.Generator().manual_seed(6)).state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    assert not all(torch.equal(a[k], c[k]) for k in a)
+
+
+def test_same_seed_same_weights_bit_for_bit():
+    xs, ys = _data()
+    a = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, cache=False, progress=False)
+    b = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, cache=False, progress=False)
+    sa, sb = a.model.state_dict(), b.model.state_dict()
+    assert all(torch.equal(sa[k], sb[k]) for k in sa)
+    assert a.history == b.history
+    np.testing.assert_array_equal(a.predict(xs[0]), b.predict(xs[0]))
+
+
+def test_training_lowers_the_loss_and_predicts_long_programs():
+    xs, ys = _data()
+    cfg = TrainConfig(seed=0, max_epochs=40, patience=40, batch_size=4, window_lines=32)
+    t = fit(ModelConfig(n_inputs=2, hidden=8), cfg, xs, ys, cache=False, progress=False)
+    assert t.history["val"][t.best_epoch - 1] < 0.5 * t.history["val"][0]
+    y = t.predict(np.concatenate(xs))  # longer than a window: overlapping windows
+    assert y.shape == (len(xs) * 90, 1) and np.isfinite(y).all()
+
+
+def test_early_stopping_keeps_best_epoch():
+    xs, ys = _data()
+    cfg = TrainConfig(seed=0, max_epochs=300, patience=2, batch_size=4, window_lines=32,
+                      learning_rate=0.3)  # fmt: skip
+    t = fit(ModelConfig(n_inputs=2, hidden=4), cfg, xs, ys, cache=False, progress=False)
+    epochs = len(t.history["val"])
+    assert epochs < 300
+    assert epochs == t.best_epoch + cfg.patience
+    assert t.history["val"][t.best_epoch - 1] == min(t.history["val"])
+
+
+def test_checkpoint_round_trip_and_cache_hit():
+    xs, ys = _data()
+    a = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, name="t", progress=False)
+    assert a.path.exists() and a.path.parent == paths.cache_dir() / "models"
+    assert not list(a.path.parent.glob("*.tmp"))
+    b = load_checkpoint(a.path)  # torch.load(..., weights_only=True)
+    assert b.model.config == a.model.config and b.train_config == CFG
+    np.testing.assert_array_equal(a.predict(xs[1]), b.predict(xs[1]))
+    c = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, name="t", progress=False)
+    assert c.path == a.path and c.train_seconds == a.train_seconds  # loaded, not retrained
+    # other data: another checkpoint
+    d = fit(ModelConfig(n_inputs=2, hidden=4), CFG, *_data(seed=9), name="t", progress=False)
+    assert d.path != a.path
+
+
+def test_scaling_uses_training_programs_only():
+    xs, ys = _data()
+    train_idx, val_idx = _split(len(xs), CFG)
+    xs[val_idx[0]] = xs[val_idx[0]] + 100.0  # an outlier among the validation programs
+    t = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, cache=False, progress=False)
+    expected = Scaler.fit([xs[i] for i in train_idx])
+    np.testing.assert_allclose(t.x_scaler.mean, expected.mean)
+    np.testing.assert_allclose(t.x_scaler.std, expected.std)
+    assert (t.x_scaler.mean < 2.0).all()  # the outlier (inputs > 100) left no trace
+
+
+def test_scaler_log_columns_and_inverse():
+    x = np.array([[1.0, 10.0], [3.0, 1000.0]])
+    s = Scaler.fit([x], log_columns=[1])
+    z = s.transform(x)
+    np.testing.assert_allclose(z.mean(axis=0), 0, atol=1e-6)
+    np.testing.assert_allclose(s.inverse(z), x, rtol=1e-6)
+
+
+def test_split_holds_out_whole_programs():
+    tr, va = _split(10, CFG)
+    assert len(va) >= 1 and set(tr).isdisjoint(va) and len(tr) + len(va) == 10
+    with pytest.raises(ValueError, match="at least 2"):
+        _split(1, CFG)
