@@ -19,7 +19,14 @@ import numpy as np
 from .motion import Motion
 from .toolpath import MotionKind, Toolpath
 
-__all__ = ["CHIEN2023_FEATURES", "BlockTargets", "block_targets", "chien2023_features"]
+__all__ = [
+    "CHIEN2023_FEATURES",
+    "SUN2022_FEATURES",
+    "BlockTargets",
+    "block_targets",
+    "chien2023_features",
+    "sun2022_features",
+]
 
 
 @dataclass(frozen=True)
@@ -140,3 +147,60 @@ def chien2023_features(toolpath: Toolpath, machine_tol_mm: float) -> np.ndarray:
             toolpath.effective_tolerance_mm(machine_tol_mm),
         ]
     )
+
+
+#: Column names of :func:`sun2022_features`, per axis ``a``.
+SUN2022_FEATURES = (
+    "cos_prev", "cos", "cos_next", "feed_prev_mm_s", "feed_mm_s", "feed_next_mm_s",
+    "acc_prev_mm_s2", "acc_mm_s2", "acc_next_mm_s2",
+)  # fmt: skip
+
+
+def sun2022_features(toolpath: Toolpath, rapid_feed_mm_s: float) -> np.ndarray:
+    r"""Input features of the per-axis networks, one row per cutter location (Sun et al. 2022,
+    Table 1, eq. 5-8).
+
+    Cutter location :math:`CL_n` is the end of block :math:`n`. With :math:`f_n` the commanded
+    feed (the rapid feed for G0), the nominal time of the block is
+    :math:`t_n = \lVert CL_n - CL_{n-1} \rVert / f_n` (eq. 5), the nominal axis feed
+    :math:`f_{a,n} = (a_n - a_{n-1}) / t_n` (eq. 6), the nominal axis acceleration
+    :math:`a_{a,n} = (f_{a,n} - f_{a,n-1}) / t_n` (eq. 7), and the angle feature is the cosine
+
+    .. math:: \theta_n = \frac{(CL_{n+1} - CL_n)\cdot(CL_{n-1} - CL_n)}
+                             {\lvert CL_{n+1} - CL_n\rvert\,\lvert CL_{n-1} - CL_n\rvert}
+        \qquad (8)
+
+    (-1 for a straight continuation, 1 for a reversal). Each axis gets these at
+    :math:`n-1, n, n+1`; the first and last rows repeat their edge values, the program starts and
+    ends at rest (zero feed), and :math:`\theta = -1` where a neighbour is missing.
+
+    Parameters
+    ----------
+    toolpath : Toolpath
+        Linear moves and rapids of non-zero length.
+    rapid_feed_mm_s : float
+        Commanded feed of G0.
+
+    Returns
+    -------
+    ndarray, shape (N, 3, 9)
+        ``[n, axis, feature]``, features in the order of :data:`SUN2022_FEATURES`.
+    """
+    d = toolpath.end_mm - toolpath.start_mm
+    length = np.linalg.norm(d, axis=1)
+    if (length <= 0).any():
+        k = int(np.flatnonzero(length <= 0)[0])
+        raise ValueError(f"block {k} (line {toolpath.line[k]}) has zero length: drop it first")
+    f = np.where(toolpath.kind == MotionKind.RAPID, rapid_feed_mm_s, toolpath.feed_mm_s)
+    t = length / f  # eq. 5
+    feed = d / t[:, None]  # eq. 6, (N, 3)
+    prev_feed = np.vstack([np.zeros((1, 3)), feed[:-1]])
+    acc = (feed - prev_feed) / t[:, None]  # eq. 7
+    u = d / length[:, None]
+    cos = np.full(len(d), -1.0)
+    cos[:-1] = -np.einsum("ij,ij->i", u[1:], u[:-1])  # eq. 8 at the end of each block
+    out = np.empty((len(d), 3, 9))
+    for j, per_line in enumerate((np.repeat(cos[:, None], 3, axis=1), feed, acc)):
+        padded = np.concatenate([per_line[:1], per_line, per_line[-1:]])
+        out[:, :, 3 * j : 3 * j + 3] = np.stack([padded[:-2], padded[1:-1], padded[2:]], axis=2)
+    return out

@@ -40,6 +40,9 @@ class ModelConfig:
         LSTM units per direction, or width of each MLP hidden layer.
     mlp_layers : int
         Hidden layers of the MLP (ignored by the LSTMs).
+    mlp_widths : tuple of int
+        Widths of the MLP's hidden layers, one per layer (e.g. ``(5, 10)``, Sun et al. 2022);
+        when given, they replace ``hidden`` and ``mlp_layers`` for the MLP.
     """
 
     kind: str = "bilstm"
@@ -47,8 +50,12 @@ class ModelConfig:
     n_outputs: int = 1
     hidden: int = 10
     mlp_layers: int = 2
+    mlp_widths: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "mlp_widths", tuple(int(w) for w in self.mlp_widths))
+        if any(w < 1 for w in self.mlp_widths):
+            raise ValueError(f"mlp_widths = {self.mlp_widths!r} is out of range: allowed >= 1")
         if self.kind not in KINDS:
             raise ValueError(f"kind = {self.kind!r} is unknown: allowed {', '.join(KINDS)}")
         for name in ("n_inputs", "n_outputs", "hidden", "mlp_layers"):
@@ -57,7 +64,9 @@ class ModelConfig:
 
     def to_dict(self) -> dict:
         """Plain dict (what the checkpoint stores)."""
-        return asdict(self)
+        d = asdict(self)
+        d["mlp_widths"] = list(self.mlp_widths)
+        return d
 
 
 class SequenceModel(nn.Module):
@@ -74,9 +83,9 @@ class SequenceModel(nn.Module):
         if c.kind == "mlp":
             layers: list[nn.Module] = []
             width = c.n_inputs
-            for _ in range(c.mlp_layers):
-                layers += [nn.Linear(width, c.hidden), nn.Tanh()]
-                width = c.hidden
+            for size in c.mlp_widths or (c.hidden,) * c.mlp_layers:
+                layers += [nn.Linear(width, size), nn.Tanh()]
+                width = size
             self.body: nn.Module = nn.Sequential(*layers)
             self.head = nn.Linear(width, c.n_outputs)
         else:

@@ -268,6 +268,7 @@ def fit(
     name: str = "model",
     cache: bool = True,
     progress: bool = True,
+    validation: tuple[Sequence[np.ndarray], Sequence[np.ndarray]] | None = None,
 ) -> Trained:
     """Train ``model_config`` on programs ``xs``/``ys``, or load the cached checkpoint.
 
@@ -283,6 +284,9 @@ def fit(
         Load a checkpoint with the same data and configs if present; save the result.
     progress : bool
         Show a tqdm bar over epochs.
+    validation : (xs, ys), optional
+        Programs to validate on, given explicitly (e.g. half of a pocket, Sun et al. 2022,
+        Table 2); then every program of ``xs``/``ys`` trains and ``val_share`` is not used.
 
     Returns
     -------
@@ -290,8 +294,9 @@ def fit(
     """
     if len(xs) != len(ys):
         raise ValueError(f"xs and ys differ in length: {len(xs)} and {len(ys)}")
+    val_key = data_hash(*validation) if validation is not None else None
     key_src = json.dumps(
-        {"data": data_hash(xs, ys), "model": model_config.to_dict(),
+        {"data": data_hash(xs, ys), "validation": val_key, "model": model_config.to_dict(),
          "train": train_config.to_dict()},
         sort_keys=True,
     )  # fmt: skip
@@ -304,7 +309,13 @@ def fit(
     torch.set_num_threads(1)
     torch.use_deterministic_algorithms(True)
     try:
-        trained = _train(model_config, train_config, xs, ys, path, progress)
+        if validation is not None:  # the given programs validate, all others train
+            n = len(xs)
+            xs, ys = [*xs, *validation[0]], [*ys, *validation[1]]
+            split = (np.arange(n), np.arange(n, len(xs)))
+        else:
+            split = _split(len(xs), train_config)
+        trained = _train(model_config, train_config, xs, ys, path, progress, split)
     finally:
         torch.set_num_threads(threads)
         torch.use_deterministic_algorithms(deterministic)
@@ -313,9 +324,9 @@ def fit(
     return trained
 
 
-def _train(model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool) -> Trained:
+def _train(model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, split) -> Trained:
     t0 = time.perf_counter()
-    train_idx, val_idx = _split(len(xs), cfg)
+    train_idx, val_idx = split
     x_scaler = Scaler.fit([xs[i] for i in train_idx], cfg.log_inputs)
     y_scaler = Scaler.fit([ys[i] for i in train_idx])
     zx = [x_scaler.transform(x) for x in xs]
@@ -409,7 +420,9 @@ def load_checkpoint(path: str | os.PathLike) -> Trained:
     """Read a checkpoint written by :func:`save_checkpoint` (``weights_only=True``)."""
     path = Path(path)
     d = torch.load(path, map_location="cpu", weights_only=True)
-    model_config = ModelConfig(**d["model_config"])
+    mc = dict(d["model_config"])
+    mc["mlp_widths"] = tuple(mc.get("mlp_widths", ()))
+    model_config = ModelConfig(**mc)
     tc = dict(d["train_config"])
     tc["log_inputs"] = tuple(tc["log_inputs"])
     model = SequenceModel(model_config)
