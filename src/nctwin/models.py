@@ -10,6 +10,9 @@ One module, one config (after nanoGPT): :class:`ModelConfig` says which network 
 * ``"lstm"`` -- the same, forward direction only (no look-ahead): an ablation.
 * ``"mlp"`` -- a per-line multilayer perceptron (tanh) that sees one G-line's features only: an
   ablation without any sequence context.
+
+:class:`BPNetwork` (config :class:`BPConfig`, made by :func:`build_bp`) is the BP network of
+Zhang et al. (2023): one sample per row, ReLU hidden layers with dropout.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from dataclasses import asdict, dataclass
 import torch
 from torch import nn
 
-__all__ = ["KINDS", "ModelConfig", "SequenceModel", "build"]
+__all__ = ["KINDS", "BPConfig", "BPNetwork", "ModelConfig", "SequenceModel", "build", "build_bp"]
 
 #: Model kinds :func:`build` knows.
 KINDS = ("bilstm", "lstm", "mlp")
@@ -123,3 +126,99 @@ def _fan_in(model: nn.Module, bias_name: str) -> int:
     """Fan-in of the layer a bias belongs to (the width of its weight's last axis)."""
     weight = dict(model.named_parameters())[bias_name.rsplit(".", 1)[0] + ".weight"]
     return int(weight.shape[-1])
+
+
+# ----------------------------------------------------------------------------------------------
+# Zhang et al. (2023): the BP network for tool-path step error
+
+
+@dataclass(frozen=True)
+class BPConfig:
+    r"""The BP network of Zhang et al. (2023, Fig. 2-3, Sec. "Network parameter determination").
+
+    Fully connected: ``n_inputs`` -> ReLU layers of ``hidden`` widths (paper: 28 and 20, sized
+    by eq. 8), each followed by dropout -> linear output. One sample per row: the network maps
+    (..., n_inputs) to (..., n_outputs), so it also runs on the (batch, lines, n_inputs) windows
+    of :mod:`nctwin.train`.
+
+    Parameters
+    ----------
+    n_inputs : int
+        Sample width (Table 1).
+    hidden : tuple of int
+        Hidden layer widths.
+    n_outputs : int
+    dropout : float
+        Probability of *dropping* a hidden unit during training, in [0, 1) (PyTorch's
+        convention; the paper's eq. 13 names the keep probability :math:`p`, but its Table 2
+        rises at large :math:`p`, as dropping, not keeping, does). 0 switches dropout off.
+    weight_init : {"normal", "uniform"}
+        ``"normal"``: weights :math:`\sim N(0, \text{weight\_std}^2)` (eq. 10; paper: N(0, 1));
+        ``"uniform"``: PyTorch's default, :math:`U(-1/\sqrt{\text{fan}_\text{in}},
+        1/\sqrt{\text{fan}_\text{in}})`. Biases are always the latter (eq. 11 gives no bounds).
+    weight_std : float
+        Standard deviation of ``"normal"`` weights, > 0.
+    """
+
+    n_inputs: int = 325
+    hidden: tuple[int, ...] = (28, 20)
+    n_outputs: int = 1
+    dropout: float = 0.5
+    weight_init: str = "normal"
+    weight_std: float = 1.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "hidden", tuple(int(h) for h in self.hidden))
+        for name in ("n_inputs", "n_outputs"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
+        if not self.hidden or any(h < 1 for h in self.hidden):
+            raise ValueError(f"hidden = {self.hidden!r} is out of range: allowed widths >= 1")
+        if not 0.0 <= self.dropout < 1.0:
+            raise ValueError(f"dropout = {self.dropout!r} is out of range: allowed [0, 1)")
+        if self.weight_init not in ("normal", "uniform"):
+            raise ValueError(
+                f"weight_init = {self.weight_init!r} is unknown: allowed normal, uniform"
+            )
+        if not self.weight_std > 0:
+            raise ValueError(f"weight_std = {self.weight_std!r} is out of range: allowed > 0")
+
+    def to_dict(self) -> dict:
+        """Plain dict (what the checkpoint stores)."""
+        d = asdict(self)
+        d["hidden"] = list(self.hidden)
+        return d
+
+
+class BPNetwork(nn.Module):
+    """The network of :class:`BPConfig`; ``forward`` maps (..., n_inputs) to (..., n_outputs)."""
+
+    def __init__(self, config: BPConfig) -> None:
+        super().__init__()
+        self.config = config
+        layers: list[nn.Module] = []
+        width = config.n_inputs
+        for size in config.hidden:
+            layers += [nn.Linear(width, size), nn.ReLU(), nn.Dropout(config.dropout)]
+            width = size
+        layers.append(nn.Linear(width, config.n_outputs))
+        self.layers = nn.Sequential(*layers)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.layers(x)
+
+
+def build_bp(config: BPConfig, *, generator: torch.Generator | None = None) -> BPNetwork:
+    """Make the network of ``config`` with weights drawn from ``generator`` (reproducible)."""
+    model = BPNetwork(config)
+    with torch.no_grad():
+        for layer in model.layers:
+            if not isinstance(layer, nn.Linear):
+                continue
+            bound = layer.in_features**-0.5
+            if config.weight_init == "normal":
+                layer.weight.normal_(0.0, config.weight_std, generator=generator)
+            else:
+                layer.weight.uniform_(-bound, bound, generator=generator)
+            layer.bias.uniform_(-bound, bound, generator=generator)
+    return model

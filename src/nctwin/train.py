@@ -50,7 +50,7 @@ import torch
 from tqdm import tqdm
 
 from . import paths
-from .models import ModelConfig, SequenceModel, build
+from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = ["Scaler", "TrainConfig", "Trained", "fit", "load_checkpoint"]
 
@@ -70,7 +70,7 @@ class TrainConfig:
     window_lines : int
         G-lines per training window (and per prediction window).
     learning_rate : float
-        Adam step size.
+        Step size of the optimiser.
     val_share : float
         Share of programs held out for validation.
     loss : {"rmse", "mse"}
@@ -78,6 +78,10 @@ class TrainConfig:
         targets.
     log_inputs : tuple of int
         Input columns standardised as logarithms (lengths spanning decades).
+    optimiser : {"adam", "sgd"}
+        Adam, or stochastic gradient descent with ``momentum`` (Zhang et al. 2023, eq. 14).
+    momentum : float
+        Momentum :math:`\beta` of ``"sgd"``, in [0, 1).
     """
 
     seed: int = 0
@@ -89,10 +93,16 @@ class TrainConfig:
     val_share: float = 0.15
     loss: str = "rmse"
     log_inputs: tuple[int, ...] = field(default_factory=tuple)
+    optimiser: str = "adam"
+    momentum: float = 0.0
 
     def __post_init__(self) -> None:
         if self.loss not in ("rmse", "mse"):
             raise ValueError(f"loss = {self.loss!r} is unknown: allowed rmse, mse")
+        if self.optimiser not in ("adam", "sgd"):
+            raise ValueError(f"optimiser = {self.optimiser!r} is unknown: allowed adam, sgd")
+        if not 0.0 <= self.momentum < 1.0:
+            raise ValueError(f"momentum = {self.momentum!r} is out of range: allowed [0, 1)")
         if not 0.0 < self.val_share < 1.0:
             raise ValueError(f"val_share = {self.val_share!r} is out of range: allowed (0, 1)")
         for name in ("max_epochs", "patience", "batch_size", "window_lines"):
@@ -102,6 +112,10 @@ class TrainConfig:
     def to_dict(self) -> dict:
         d = asdict(self)
         d["log_inputs"] = list(self.log_inputs)
+        # left out at their defaults, so that checkpoints made before they existed keep their keys
+        for name, default in (("optimiser", "adam"), ("momentum", 0.0)):
+            if d[name] == default:
+                del d[name]
         return d
 
 
@@ -153,7 +167,7 @@ class Trained:
 
     Parameters
     ----------
-    model : SequenceModel
+    model : SequenceModel or BPNetwork
         In evaluation mode, best validation weights.
     x_scaler, y_scaler : Scaler
     train_config : TrainConfig
@@ -167,7 +181,7 @@ class Trained:
         The checkpoint.
     """
 
-    model: SequenceModel
+    model: SequenceModel | BPNetwork
     x_scaler: Scaler
     y_scaler: Scaler
     train_config: TrainConfig
@@ -184,7 +198,7 @@ class Trained:
         z = torch.from_numpy(self.x_scaler.transform(x))
         n, w = len(z), self.train_config.window_lines
         with torch.no_grad():
-            if n <= w:
+            if n <= w or isinstance(self.model, BPNetwork):  # one row at a time: no windows
                 out = self.model(z[None])[0].numpy()
             else:
                 core = max(w // 2, 1)
@@ -260,7 +274,7 @@ def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) ->
 
 
 def fit(
-    model_config: ModelConfig,
+    model_config: ModelConfig | BPConfig,
     train_config: TrainConfig,
     xs: Sequence[np.ndarray],
     ys: Sequence[np.ndarray],
@@ -269,12 +283,13 @@ def fit(
     cache: bool = True,
     progress: bool = True,
     validation: tuple[Sequence[np.ndarray], Sequence[np.ndarray]] | None = None,
+    init: Trained | None = None,
 ) -> Trained:
     """Train ``model_config`` on programs ``xs``/``ys``, or load the cached checkpoint.
 
     Parameters
     ----------
-    model_config : ModelConfig
+    model_config : ModelConfig or BPConfig
     train_config : TrainConfig
     xs, ys : sequences of ndarray, shapes (N_i, n_inputs) and (N_i, n_outputs)
         One entry per program.
@@ -287,6 +302,9 @@ def fit(
     validation : (xs, ys), optional
         Programs to validate on, given explicitly (e.g. half of a pocket, Sun et al. 2022,
         Table 2); then every program of ``xs``/``ys`` trains and ``val_share`` is not used.
+    init : Trained, optional
+        Fine-tune: start from these weights and keep their scalers (the inputs of a trained
+        network keep the scaling it learned with); ``model_config`` must be its config.
 
     Returns
     -------
@@ -294,12 +312,16 @@ def fit(
     """
     if len(xs) != len(ys):
         raise ValueError(f"xs and ys differ in length: {len(xs)} and {len(ys)}")
+    if init is not None and init.model.config != model_config:
+        raise ValueError(
+            f"init has model config {init.model.config!r}, not model_config = {model_config!r}"
+        )
     val_key = data_hash(*validation) if validation is not None else None
-    key_src = json.dumps(
-        {"data": data_hash(xs, ys), "validation": val_key, "model": model_config.to_dict(),
-         "train": train_config.to_dict()},
-        sort_keys=True,
-    )  # fmt: skip
+    key = {"data": data_hash(xs, ys), "validation": val_key, "model": model_config.to_dict(),
+           "train": train_config.to_dict()}  # fmt: skip
+    if init is not None:  # only then, so that earlier keys stay valid
+        key["init"] = init.path.name
+    key_src = json.dumps(key, sort_keys=True)
     path = _checkpoint_path(name, hashlib.sha256(key_src.encode()).hexdigest())
     if cache and path.exists():
         return load_checkpoint(path)
@@ -315,7 +337,7 @@ def fit(
             split = (np.arange(n), np.arange(n, len(xs)))
         else:
             split = _split(len(xs), train_config)
-        trained = _train(model_config, train_config, xs, ys, path, progress, split)
+        trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     finally:
         torch.set_num_threads(threads)
         torch.use_deterministic_algorithms(deterministic)
@@ -324,18 +346,33 @@ def fit(
     return trained
 
 
-def _train(model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, split) -> Trained:
+def _train(
+    model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, split, init=None
+) -> Trained:
     t0 = time.perf_counter()
     train_idx, val_idx = split
-    x_scaler = Scaler.fit([xs[i] for i in train_idx], cfg.log_inputs)
-    y_scaler = Scaler.fit([ys[i] for i in train_idx])
+    if init is not None:
+        x_scaler, y_scaler = init.x_scaler, init.y_scaler
+    else:
+        x_scaler = Scaler.fit([xs[i] for i in train_idx], cfg.log_inputs)
+        y_scaler = Scaler.fit([ys[i] for i in train_idx])
     zx = [x_scaler.transform(x) for x in xs]
     zy = [y_scaler.transform(y) for y in ys]
     w = cfg.window_lines
     generator = torch.Generator().manual_seed(cfg.seed)
     rng = np.random.default_rng([cfg.seed, 2])
-    model = build(model_config, generator=generator)
-    optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+    if isinstance(model_config, BPConfig):
+        model = build_bp(model_config, generator=generator)
+    else:
+        model = build(model_config, generator=generator)
+    if init is not None:
+        model.load_state_dict(init.model.state_dict())
+    if cfg.optimiser == "sgd":
+        optimiser = torch.optim.SGD(
+            model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
+        )
+    else:
+        optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
     val_windows = _windows([len(zx[i]) for i in val_idx], w, None)
     vx, vy, vm = _batch([zx[i] for i in val_idx], [zy[i] for i in val_idx], val_windows, w)
     tx = [zx[i] for i in train_idx]
@@ -367,7 +404,7 @@ def _train(model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, s
             val = float(_loss(model(vx), vy, vm, cfg.loss))
         history["train"].append(total / count)
         history["val"].append(val)
-        bar.set_postfix(train=f"{total / count:.4f}", val=f"{val:.4f}")
+        bar.set_postfix(train=f"{total / count:.4f}", val=f"{val:.4f}", refresh=False)
         if val < best:
             best, best_state, best_epoch, stale = val, copy.deepcopy(model.state_dict()), epoch, 0
         else:
@@ -396,6 +433,7 @@ def save_checkpoint(trained: Trained) -> Path:
     path = trained.path
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {
+        "model_type": type(trained.model.config).__name__,
         "model_config": trained.model.config.to_dict(),
         "train_config": trained.train_config.to_dict(),
         "state_dict": trained.model.state_dict(),
@@ -421,11 +459,13 @@ def load_checkpoint(path: str | os.PathLike) -> Trained:
     path = Path(path)
     d = torch.load(path, map_location="cpu", weights_only=True)
     mc = dict(d["model_config"])
-    mc["mlp_widths"] = tuple(mc.get("mlp_widths", ()))
-    model_config = ModelConfig(**mc)
+    if d.get("model_type") == "BPConfig":
+        model: SequenceModel | BPNetwork = BPNetwork(BPConfig(**mc))
+    else:
+        mc["mlp_widths"] = tuple(mc.get("mlp_widths", ()))
+        model = SequenceModel(ModelConfig(**mc))
     tc = dict(d["train_config"])
     tc["log_inputs"] = tuple(tc["log_inputs"])
-    model = SequenceModel(model_config)
     model.load_state_dict(d["state_dict"])
     model.eval()
     return Trained(

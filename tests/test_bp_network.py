@@ -1,0 +1,89 @@
+"""The BP network of Zhang et al. (2023) and the training-loop options it needs (SGD with
+momentum, N(0, 1) weights, dropout, fine-tuning from a trained network)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from nctwin import paths
+from nctwin.models import BPConfig, BPNetwork, build_bp
+from nctwin.train import TrainConfig, fit, load_checkpoint
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path, monkeypatch):
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path))
+    assert paths.cache_dir() == tmp_path / "cache"
+
+
+def _rows(n=400, seed=0, shift=0.0):
+    """Rows in chunks of 8 (the loop's programs); target a smooth function of the inputs."""
+    rng = np.random.default_rng(seed)
+    x = rng.normal(shift, 1.0, (n, 6))
+    y = (x[:, :1] ** 2 + np.sin(x[:, 1:2])) / 2
+    return np.split(x, n // 8), np.split(y, n // 8)
+
+
+CFG = TrainConfig(
+    seed=3, max_epochs=30, patience=30, batch_size=10, window_lines=8, learning_rate=1e-2,
+    loss="mse", optimiser="sgd", momentum=0.8, val_share=0.1,
+)  # fmt: skip
+
+
+def test_paper_initialisation_is_standard_normal_and_seeded() -> None:
+    config = BPConfig(n_inputs=325)
+    a = build_bp(config, generator=torch.Generator().manual_seed(0))
+    b = build_bp(config, generator=torch.Generator().manual_seed(0))
+    w = a.layers[0].weight.detach().numpy()
+    assert w.shape == (28, 325)
+    assert abs(w.mean()) < 0.02 and abs(w.std() - 1.0) < 0.02
+    for pa, pb in zip(a.parameters(), b.parameters(), strict=True):
+        assert torch.equal(pa, pb)
+    uniform = build_bp(BPConfig(n_inputs=325, weight_init="uniform"))
+    assert uniform.layers[0].weight.abs().max() <= 325**-0.5
+    dropouts = [m.p for m in a.layers if isinstance(m, torch.nn.Dropout)]
+    assert dropouts == [0.5, 0.5]  # after each hidden layer
+
+
+def test_sgd_with_momentum_learns_and_the_checkpoint_round_trips() -> None:
+    xs, ys = _rows()
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.0, weight_init="uniform")
+    trained = fit(config, CFG, xs, ys, name="bp", progress=False)
+    assert trained.history["train"][-1] < 0.5 * trained.history["train"][0]
+    again = fit(config, CFG, xs, ys, name="bp", progress=False)  # from the cache
+    loaded = load_checkpoint(trained.path)
+    assert isinstance(loaded.model, BPNetwork) and loaded.model.config == config
+    x = np.concatenate(xs)
+    np.testing.assert_array_equal(loaded.predict(x), trained.predict(x))
+    np.testing.assert_array_equal(again.predict(x), trained.predict(x))
+    assert trained.predict(x).shape == (len(x), 1)
+
+
+def test_fine_tuning_starts_from_the_weights_and_keeps_the_scalers() -> None:
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.0, weight_init="uniform")
+    base = fit(config, CFG, *_rows(), name="bp", progress=False)
+    xs, ys = _rows(160, seed=1, shift=0.5)
+    tuned = fit(config, CFG, xs, ys, name="bp", progress=False, init=base)
+    np.testing.assert_array_equal(tuned.x_scaler.mean, base.x_scaler.mean)
+    assert tuned.path != base.path
+    # the first epoch of fine-tuning starts where the base network is, not from scratch
+    scratch = fit(config, CFG, xs, ys, name="bp", progress=False)
+    assert tuned.history["train"][0] < scratch.history["train"][0]
+    with pytest.raises(ValueError, match="model_config"):
+        fit(BPConfig(n_inputs=6), CFG, xs, ys, progress=False, init=base)
+
+
+def test_bad_parameters_raise() -> None:
+    with pytest.raises(ValueError, match="dropout"):
+        BPConfig(dropout=1.0)
+    with pytest.raises(ValueError, match="weight_init"):
+        BPConfig(weight_init="xavier")
+    with pytest.raises(ValueError, match="hidden"):
+        BPConfig(hidden=(28, 0))
+    with pytest.raises(ValueError, match="optimiser"):
+        TrainConfig(optimiser="rmsprop")
+    with pytest.raises(ValueError, match="momentum"):
+        TrainConfig(momentum=1.0)
+    assert "optimiser" not in TrainConfig().to_dict()  # default keys of old checkpoints unchanged
