@@ -26,6 +26,10 @@ HOME_MM = (620.0, 260.0, 60.0)
 
 _SAFE_Z = 5.0
 
+#: Longest G1 segment: CAM systems output adaptive (HPC) roughing paths as dense point
+#: sequences; the paper's pocket 1 has 5383 cutter locations over about 18 m (3.4 mm each).
+MAX_SEGMENT_MM = 3.0
+
 #: Smallest corner radius of the offsets: HPC toolpaths round every corner (mm).
 MIN_CORNER_MM = 3.0
 
@@ -91,6 +95,15 @@ def _rounded_rect(cx, cy, w, h, r, seg_mm):
             pts.append((cx + ox, cy + oy))
     pts.append(pts[0])
     return np.array(pts)
+
+
+def _split_long(poly: np.ndarray, max_len: float) -> np.ndarray:
+    """The polyline with every segment longer than ``max_len`` split into equal pieces."""
+    seg = np.diff(poly, axis=0)
+    parts = np.maximum(1, np.ceil(np.linalg.norm(seg, axis=1) / max_len).astype(np.int64))
+    k = np.repeat(np.arange(len(seg)), parts)
+    frac = (np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[k]
+    return np.vstack([poly[k] + frac[:, None] * seg[k], poly[-1:]])
 
 
 def _circle(cx, cy, r, seg_mm, start_angle=-0.5 * math.pi):
@@ -249,7 +262,8 @@ def pocket_program(spec: PocketSpec, *, stepover_mm: float = 4.0, segment_mm: fl
             for i, contour in enumerate(region):
                 if i:
                     lines.append(f"G1 X{contour[0, 0]:.4f} Y{contour[0, 1]:.4f}")  # link
-                lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in contour[1:]]
+                dense = _split_long(contour, MAX_SEGMENT_MM)
+                lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in dense[1:]]
             lines.append(f"G0 Z{_SAFE_Z:.1f}")
     lines += [f"G0 Z{HOME_MM[2]:.1f}", "M30"]
     return "\n".join(lines) + "\n"
