@@ -1,0 +1,419 @@
+r"""The experiment of Chien, Sencer & Ward (2023): run programs on the FIR kernel, learn the
+average feed per G-line, predict cycle times.
+
+Per program (Sec. 2.2, eq. 1-3): the features of :func:`nctwin.features.chien2023_features`,
+and two targets per G-line read from the kernel's motion at the junction points,
+
+* the average feed :math:`\bar f_k = \tilde l_k / \tilde t_k` (eq. 2), and
+* the time ratio :math:`s_k = F \tilde t_k / l_k` (1 where the tool runs the G-line at the
+  programmed feed; what CAM assumes everywhere).
+
+Eq. 3, :math:`T = \sum_k \tilde l_k / \bar f_k = \sum_k \tilde t_k`, needs the blended lengths
+:math:`\tilde l_k`, which are not known before the program runs and which the paper does not
+say how it obtains; using the nominal :math:`l_k` instead overestimates :math:`T` by 4-8 % on the
+test contours (the blends cut corners by up to :math:`\varepsilon`). And a network trained with a
+squared loss predicts the conditional *mean* of each output, so a cycle time formed from a ratio
+of two predictions is biased where the targets are noisy (the junction points of sub-millimetre
+G-lines). The networks therefore predict :math:`s_k` as a second output, and the predicted cycle
+time is eq. 3 per G-line, linear in the prediction:
+
+.. math:: \hat T = \sum_k \hat s_k\, l_k / F .
+
+The average feed :math:`\hat{\bar f}_k` is what Figs. 7 and 9 show.
+
+Where a G-line's two junction points are the same sample (:math:`\tilde t_k = 0`, a fraction of a
+percent of the short G-lines), :math:`\bar f_k` is undefined and left out of the loss.
+
+"Machine B" (Table 3) is recorded the way a real control's trace is: :class:`Recording` adds a
+first-order position loop (servo lag, with the wait for the in-position window at the end) and
+encoder noise to the kernel's command positions before the targets are read.
+
+Simulations of a list of programs run through :mod:`joblib` (one task per program) and are
+cached in ``data/cache/chien2023/`` under a hash of the programs' text, the machine and the
+recording, written atomically.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from scipy.signal import lfilter
+from tqdm import tqdm
+
+from . import gcode, paths
+from .estimate import cam
+from .features import block_targets, chien2023_features
+from .kernel import fir
+from .machine import MachineProfile
+from .motion import Motion
+from .tables import error_pct, side_by_side
+from .toolpath import MotionKind, Toolpath
+from .train import Trained
+
+__all__ = [
+    "MIN_FEED_MM_S",
+    "TABLE_COLUMNS",
+    "ProgramRun",
+    "Recording",
+    "ablation_table",
+    "cutting_blocks",
+    "cycle_time_rows",
+    "feed_rmse_mm_s",
+    "paper_beside",
+    "plot_feed_per_line",
+    "predict_run",
+    "simulate",
+    "simulate_one",
+    "write_programs",
+]
+
+#: Cache format version (part of every cache key).
+CACHE_VERSION = 2
+#: Floor of a predicted average feed (mm/s), so that a prediction near 0 stays a finite time.
+MIN_FEED_MM_S = 1.0
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What a real control's recorded trace adds to the kernel's command positions.
+
+    Parameters
+    ----------
+    position_gain_1_s : float
+        Gain ``Kv`` of a first-order position loop per axis (1/s); the actual position lags the
+        command by ``F / Kv``. 0: no lag (the simulation profile).
+    in_position_mm : float
+        The motion ends when every axis is this close to the end point.
+    noise_mm : float
+        Standard deviation of the encoder noise on every recorded position.
+    seed : int
+        Seed of the noise (combined with the program's index).
+    """
+
+    position_gain_1_s: float = 0.0
+    in_position_mm: float = 0.001
+    noise_mm: float = 0.0
+    seed: int = 0
+
+    def apply(self, motion: Motion, rng: np.random.Generator) -> Motion:
+        """The recorded motion: lagged, extended until in position, noisy."""
+        ts = motion.period_s
+        pos = motion.pos_mm
+        block = motion.block
+        if self.position_gain_1_s > 0:
+            a = 1.0 - np.exp(-self.position_gain_1_s * ts)
+            # settle: the lag decays by (1 - a) per sample from at most the largest lag
+            lag_mm = np.abs(pos - np.roll(pos, 1, axis=0))[1:].max(initial=0.0) / a
+            extra = int(np.ceil(np.log(self.in_position_mm / max(lag_mm, 1e-12)) / np.log(1 - a)))
+            extra = max(extra, 0)
+            cmd = np.vstack([pos, np.repeat(pos[-1:], extra, axis=0)])
+            # y[n] = (1 - a) y[n-1] + a x[n-1], at rest on the first command position
+            pos = np.column_stack(
+                [lfilter([0.0, a], [1.0, a - 1.0], cmd[:, i], zi=cmd[:1, i])[0] for i in range(3)]
+            )
+            block = np.concatenate([block, np.full(extra, block[-1])])
+        if self.noise_mm > 0:
+            pos = pos + rng.normal(0.0, self.noise_mm, pos.shape)
+        vel = np.zeros_like(pos)
+        vel[1:] = np.diff(pos, axis=0) / ts
+        return Motion(np.arange(len(pos)) * ts, pos, vel, block, ts)
+
+
+@dataclass(frozen=True)
+class ProgramRun:
+    """A program run on the kernel: features, targets and times.
+
+    Parameters
+    ----------
+    features : ndarray, shape (N, 5)
+        :func:`nctwin.features.chien2023_features`.
+    targets : ndarray, shape (N, 2)
+        Average feed :math:`\\bar f_k` (mm/s, NaN where undefined) and time ratio :math:`s_k`.
+    block_time_s : ndarray, shape (N,)
+        Measured time between junction points, :math:`\\tilde t_k`.
+    measured_s : float
+        Measured cycle time, eq. 3 (the sum of ``block_time_s``).
+    cam_s : float
+        CAM estimate (length over feed).
+    """
+
+    features: np.ndarray
+    targets: np.ndarray
+    block_time_s: np.ndarray
+    measured_s: float
+    cam_s: float
+
+
+def cutting_blocks(tp: Toolpath) -> Toolpath:
+    """The planar feed moves of a program (drops rapids, plunges and retracts)."""
+    planar = np.abs(tp.end_mm[:, 2] - tp.start_mm[:, 2]) == 0
+    return tp.take((tp.kind == MotionKind.LINEAR) & planar & (tp.lengths_mm > 0))
+
+
+def simulate_one(
+    text: str, machine: MachineProfile, recording: Recording | None = None, index: int = 0
+) -> ProgramRun:
+    """Parse ``text``, keep its cutting blocks, run them on the FIR kernel and read the targets.
+
+    ``index`` seeds the recording's noise together with ``recording.seed``.
+    """
+    tp = cutting_blocks(gcode.parse(text))
+    motion = fir.run(tp, machine)
+    if recording is not None:
+        motion = recording.apply(motion, np.random.default_rng([recording.seed, index]))
+    bt = block_targets(motion, tp)
+    lengths = tp.lengths_mm
+    targets = np.column_stack([bt.avg_feed_mm_s, tp.feed_mm_s * bt.time_s / lengths])
+    return ProgramRun(
+        chien2023_features(tp, machine.blend_tol_mm),
+        targets,
+        bt.time_s,
+        bt.cycle_time_s,
+        cam(tp, machine).cycle_time_s,
+    )
+
+
+def _cache_key(texts: Sequence[str], machine: MachineProfile, recording: Recording | None) -> str:
+    h = hashlib.sha256()
+    for t in texts:
+        h.update(hashlib.sha256(t.encode()).digest())
+    meta = {
+        "version": CACHE_VERSION,
+        "machine": {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(machine).items()},
+        "recording": None if recording is None else asdict(recording),
+    }
+    h.update(json.dumps(meta, sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def _save_runs(path, runs: Sequence[ProgramRun]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp.npz")
+    os.close(fd)
+    try:
+        np.savez(
+            tmp,
+            offsets=np.cumsum([0] + [len(r.features) for r in runs]),
+            features=np.concatenate([r.features for r in runs]),
+            targets=np.concatenate([r.targets for r in runs]),
+            block_time_s=np.concatenate([r.block_time_s for r in runs]),
+            measured_s=np.array([r.measured_s for r in runs]),
+            cam_s=np.array([r.cam_s for r in runs]),
+        )
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _load_runs(path) -> list[ProgramRun]:
+    with np.load(path) as d:
+        o = d["offsets"]
+        return [
+            ProgramRun(
+                d["features"][a:b],
+                d["targets"][a:b],
+                d["block_time_s"][a:b],
+                float(d["measured_s"][i]),
+                float(d["cam_s"][i]),
+            )
+            for i, (a, b) in enumerate(itertools.pairwise(o))
+        ]
+
+
+def simulate(
+    texts: Sequence[str],
+    machine: MachineProfile,
+    *,
+    recording: Recording | None = None,
+    n_jobs: int = 2,
+    desc: str = "programs",
+    cache: bool = True,
+) -> list[ProgramRun]:
+    """Run every program of ``texts`` (see :func:`simulate_one`), through joblib, cached.
+
+    Parameters
+    ----------
+    texts : sequence of str
+        G-code programs.
+    machine : MachineProfile
+    recording : Recording, optional
+        Servo lag and noise of a real control's trace (program ``i`` draws its noise with
+        ``[recording.seed, i]``).
+    n_jobs : int
+        joblib workers.
+    desc : str
+        Label of the progress bar.
+    cache : bool
+        Read and write ``data/cache/chien2023/<hash>.npz``.
+
+    Returns
+    -------
+    list of ProgramRun
+        In the order of ``texts``.
+    """
+    path = paths.cache_dir() / "chien2023" / f"{_cache_key(texts, machine, recording)}.npz"
+    if cache and path.exists():
+        return _load_runs(path)
+    jobs = (delayed(simulate_one)(t, machine, recording, i) for i, t in enumerate(texts))
+    parallel = Parallel(n_jobs=n_jobs, return_as="generator")
+    runs = list(tqdm(parallel(jobs), total=len(texts), desc=desc, leave=False, mininterval=5.0))
+    if cache:
+        _save_runs(path, runs)
+    return runs
+
+
+def predict_run(trained: Trained, run: ProgramRun) -> tuple[np.ndarray, np.ndarray, float]:
+    """Predicted average feeds, block times and cycle time of one program.
+
+    Returns
+    -------
+    avg_feed_mm_s : ndarray, shape (N,)
+        :math:`\\hat{\\bar f}_k`, at least :data:`MIN_FEED_MM_S`.
+    block_time_s : ndarray, shape (N,)
+        :math:`\\hat s_k l_k / F` (a negative prediction counts as 0).
+    cycle_time_s : float
+        Their sum (eq. 3).
+    """
+    y = trained.predict(run.features)
+    feed = np.maximum(y[:, 0], MIN_FEED_MM_S)
+    t = np.maximum(y[:, 1], 0.0) * run.features[:, 1] / run.features[:, 0]
+    return feed, t, float(t.sum())
+
+
+def cycle_time_rows(
+    runs: dict[tuple[str, float, float], ProgramRun], models: dict[str, Trained]
+) -> pd.DataFrame:
+    """Measured, predicted and CAM cycle times per test program, with errors in percent.
+
+    Parameters
+    ----------
+    runs : dict
+        ``(toolpath, feed_mm_s, tol_mm) -> ProgramRun``.
+    models : dict
+        ``name -> Trained``; each adds ``<name>_s`` and ``<name>_err_pct`` columns.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``toolpath, feed_mm_s, tol_mm, measured_s, <name>_s, <name>_err_pct, ...,
+        cam_s, cam_err_pct``, one row per key in the order of ``runs``.
+    """
+    rows = []
+    for (name, feed, tol), run in runs.items():
+        row = {"toolpath": name, "feed_mm_s": feed, "tol_mm": tol, "measured_s": run.measured_s}
+        for m, trained in models.items():
+            t = predict_run(trained, run)[2]
+            row[f"{m}_s"] = t
+            row[f"{m}_err_pct"] = error_pct(t, run.measured_s)
+        row["cam_s"] = run.cam_s
+        row["cam_err_pct"] = error_pct(run.cam_s, run.measured_s)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def feed_rmse_mm_s(trained: Trained, runs: Sequence[ProgramRun]) -> float:
+    """Root mean square error of the predicted average feed over all G-lines of ``runs``."""
+    err = np.concatenate([predict_run(trained, r)[0] - r.targets[:, 0] for r in runs])
+    return float(np.sqrt(np.nanmean(err**2)))
+
+
+def plot_feed_per_line(
+    measured_mm_s: np.ndarray,
+    predicted_mm_s: np.ndarray,
+    *,
+    ax=None,
+    lines: tuple[int, int] | None = None,
+    title: str | None = None,
+):
+    """Measured and predicted average feed per G-line (Figs. 7 and 9); only draws.
+
+    ``lines`` selects a range of G-line numbers (from 1) to show. Returns the Axes.
+    """
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(9, 3.2), constrained_layout=True)
+    k = np.arange(1, len(measured_mm_s) + 1)
+    sel = slice(None) if lines is None else slice(lines[0] - 1, lines[1])
+    ax.plot(k[sel], measured_mm_s[sel], lw=1.0, color="0.3", label="measured (kernel)")
+    ax.plot(k[sel], predicted_mm_s[sel], lw=1.0, color="C1", ls="--", label="BiLSTM")
+    ax.set_xlabel("G-line")
+    ax.set_ylabel("average feed (mm/s)")
+    ax.set_ylim(bottom=0)
+    ax.legend(loc="lower right", frameon=False)
+    if title:
+        ax.set_title(title)
+    return ax
+
+
+#: Columns of ``results/chien2023_bilstm/table{1,2,3}.csv`` (the chapter's contract).
+TABLE_COLUMNS = (
+    "toolpath", "feed_mm_s", "tol_mm", "measured_s", "bilstm_s", "bilstm_err_pct", "cam_s",
+    "cam_err_pct", "paper_measured_s", "paper_bilstm_err_pct", "paper_cam_err_pct",
+)  # fmt: skip
+
+
+def paper_beside(rows: pd.DataFrame, paper: pd.DataFrame, *, decimals: int = 2) -> pd.DataFrame:
+    """Our cycle-time rows beside the paper's, with exactly :data:`TABLE_COLUMNS`, rounded."""
+    out = side_by_side(
+        rows[["toolpath", "feed_mm_s", "tol_mm", "measured_s", "bilstm_s", "bilstm_err_pct",
+              "cam_s", "cam_err_pct"]],
+        paper,
+        on=["toolpath", "feed_mm_s", "tol_mm"],
+        columns=["measured_s", "bilstm_err_pct", "cam_err_pct"],
+    )  # fmt: skip
+    out = out[list(TABLE_COLUMNS)]
+    values = [c for c in TABLE_COLUMNS if c not in ("toolpath", "feed_mm_s", "tol_mm")]
+    return out.assign(**{c: out[c].round(decimals) for c in values})
+
+
+def ablation_table(rows: pd.DataFrame, models: dict[str, Trained], runs) -> pd.DataFrame:
+    """Cycle-time errors and feed RMSE of each model on the same test programs.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        From :func:`cycle_time_rows` with every model of ``models``.
+    models : dict
+        ``name -> Trained``.
+    runs : sequence of ProgramRun
+        The test programs (for the per-G-line feed RMSE).
+    """
+    out = []
+    for name, trained in models.items():
+        err = rows[f"{name}_err_pct"]
+        out.append(
+            {
+                "model": name,
+                "parameters": sum(p.numel() for p in trained.model.parameters()),
+                "mean_err_pct": err.mean(),
+                "max_err_pct": err.max(),
+                "feed_rmse_mm_s": feed_rmse_mm_s(trained, runs),
+                "epochs": trained.best_epoch,
+            }
+        )
+    return pd.DataFrame(out).round(2)
+
+
+def write_programs(texts: dict[str, str], folder: str | os.PathLike) -> list[Path]:
+    """Write programs as ``<folder>/<name>.nc`` (for a reader to open); returns the paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name, text in texts.items():
+        path = folder / f"{name}.nc"
+        path.write_text(text, encoding="utf-8")
+        out.append(path)
+    return out
