@@ -1,0 +1,70 @@
+"""Sun et al. (2022): the features of Table 1 (eq. 5-8) by hand, and eq. 9-10."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nctwin import parse
+from nctwin.features import SUN2022_FEATURES, sun2022_features
+from nctwin.models import ModelConfig, build
+
+
+def test_features_by_hand():
+    # 3-4-5 triangle legs at 600 mm/min (10 mm/s), then a rapid straight back
+    tp = parse("G1 X30 F600\nY40\nG0 X0 Y0")
+    f = sun2022_features(tp, rapid_feed_mm_s=500.0)
+    assert f.shape == (3, 3, len(SUN2022_FEATURES))
+    # eq. 5-6: block 0 takes 3 s, X feed 10 mm/s; block 1: Y feed 10 mm/s
+    np.testing.assert_allclose(f[0, :, 4], [10.0, 0.0, 0.0])
+    np.testing.assert_allclose(f[1, :, 4], [0.0, 10.0, 0.0])
+    # the rapid: 50 mm at 500 mm/s, direction (-0.6, -0.8)
+    np.testing.assert_allclose(f[2, :, 4], [-300.0, -400.0, 0.0])
+    # eq. 7: block 1's X acceleration (0 - 10) / 4 s; block 0 starts from rest: 10 / 3 s
+    assert f[1, 0, 7] == pytest.approx(-2.5)
+    assert f[0, 0, 7] == pytest.approx(10.0 / 3.0)
+    # eq. 8: a right angle has cosine 0; the end of the program counts as straight on (-1)
+    assert f[0, 0, 1] == pytest.approx(0.0, abs=1e-12)
+    # at CL_1 = (30, 40): (CL_2 - CL_1) . (CL_0 - CL_1) = (-30, -40) . (0, -40) = 1600 over 50 * 40
+    assert f[1, 0, 1] == pytest.approx(0.8)
+    assert f[2, 0, 1] == -1.0
+    # n-1 and n+1 columns are the neighbours' values, edges repeated
+    np.testing.assert_allclose(f[1, :, 3], f[0, :, 4])
+    np.testing.assert_allclose(f[1, :, 5], f[2, :, 4])
+    np.testing.assert_allclose(f[0, :, 3], f[0, :, 4])
+
+
+def test_zero_length_blocks_are_refused():
+    with pytest.raises(ValueError, match="zero length"):
+        sun2022_features(parse("G1 X1 F60\nX1"), 500.0)
+
+
+def test_mlp_widths_build_the_papers_network():
+    model = build(ModelConfig(kind="mlp", n_inputs=9, n_outputs=1, mlp_widths=(5, 10)))
+    shapes = [tuple(p.shape) for p in model.parameters()]
+    assert shapes == [(5, 9), (5,), (10, 5), (10,), (1, 10), (1,)]
+    with pytest.raises(ValueError, match="mlp_widths"):
+        ModelConfig(kind="mlp", mlp_widths=(5, 0))
+
+
+class _Constant:
+    """Stands in for a trained network: predicts one feed everywhere."""
+
+    def __init__(self, value: float) -> None:
+        self.value = value
+
+    def predict(self, x: np.ndarray) -> np.ndarray:
+        return np.full((len(x), 1), self.value)
+
+
+def test_eq9_eq10_by_hand():
+    from nctwin.machine import load_machine
+    from nctwin.sun2022 import oracle_time, predict_time, run_pocket
+
+    run = run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_machine("sun2022_siemens"))
+    # axis feeds (3, 4, 0) give a resultant of 5 mm/s (eq. 9): 70 mm take 14 s (eq. 10)
+    t, resultant = predict_time([_Constant(3.0), _Constant(4.0), _Constant(0.0)], run)
+    np.testing.assert_allclose(resultant, 5.0)
+    assert t == pytest.approx(70.0 / 5.0)
+    # block averages over a long, simple path: eq. 10 gives the machine's time back closely
+    assert oracle_time(run, "true") == pytest.approx(run.measured_s, rel=0.01)
