@@ -113,3 +113,19 @@ def test_split_holds_out_whole_programs():
     assert len(va) >= 1 and set(tr).isdisjoint(va) and len(tr) + len(va) == 10
     with pytest.raises(ValueError, match="at least 2"):
         _split(1, CFG)
+
+
+def test_stacked_lstm_with_dropout_and_unchanged_default_keys():
+    """lstm_layers/dropout build a stacked LSTM; at their defaults the config dict (hence every
+    existing checkpoint key) is what it was before they existed."""
+    base = ModelConfig(kind="lstm", n_inputs=4, hidden=5)
+    assert "lstm_layers" not in base.to_dict() and "dropout" not in base.to_dict()
+    stacked = ModelConfig(kind="lstm", n_inputs=4, hidden=5, lstm_layers=3, dropout=0.2)
+    assert stacked.to_dict()["lstm_layers"] == 3
+    model = build(stacked, generator=torch.Generator().manual_seed(0))
+    assert model.body.num_layers == 3 and model.body.dropout == 0.2
+    assert model(torch.zeros(2, 7, 4)).shape == (2, 7, 1)
+    with pytest.raises(ValueError, match="dropout"):
+        ModelConfig(dropout=1.0)
+    with pytest.raises(ValueError, match="lstm_layers"):
+        ModelConfig(lstm_layers=0)

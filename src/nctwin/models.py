@@ -7,7 +7,9 @@ One module, one config (after nanoGPT): :class:`ModelConfig` says which network 
 * ``"bilstm"`` -- Chien, Sencer & Ward (2023, Sec. 4.1, Fig. 4): one bidirectional LSTM layer
   (tanh, ``hidden`` units per direction) and a fully connected linear output. The backward
   direction reads the G-lines that follow, as the NC kernel's look-ahead does.
-* ``"lstm"`` -- the same, forward direction only (no look-ahead): an ablation.
+* ``"lstm"`` -- the same, forward direction only (no look-ahead): an ablation; with
+  ``lstm_layers`` > 1 a stack of LSTM layers with ``dropout`` between them (Denkena et al. 2020,
+  Sec. 2.3: three layers of 20 cells).
 * ``"mlp"`` -- a per-line multilayer perceptron (tanh) that sees one G-line's features only: an
   ablation without any sequence context.
 
@@ -46,6 +48,12 @@ class ModelConfig:
     mlp_widths : tuple of int
         Widths of the MLP's hidden layers, one per layer (e.g. ``(5, 10)``, Sun et al. 2022);
         when given, they replace ``hidden`` and ``mlp_layers`` for the MLP.
+    lstm_layers : int
+        Stacked LSTM layers (ignored by the MLP); default 1.
+    dropout : float
+        Probability of dropping an output of every LSTM layer but the last during training
+        (PyTorch's ``nn.LSTM(dropout=...)``), in [0, 1); needs ``lstm_layers`` > 1 to act.
+        Default 0.
     """
 
     kind: str = "bilstm"
@@ -54,6 +62,8 @@ class ModelConfig:
     hidden: int = 10
     mlp_layers: int = 2
     mlp_widths: tuple[int, ...] = ()
+    lstm_layers: int = 1
+    dropout: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mlp_widths", tuple(int(w) for w in self.mlp_widths))
@@ -61,14 +71,22 @@ class ModelConfig:
             raise ValueError(f"mlp_widths = {self.mlp_widths!r} is out of range: allowed >= 1")
         if self.kind not in KINDS:
             raise ValueError(f"kind = {self.kind!r} is unknown: allowed {', '.join(KINDS)}")
-        for name in ("n_inputs", "n_outputs", "hidden", "mlp_layers"):
+        for name in ("n_inputs", "n_outputs", "hidden", "mlp_layers", "lstm_layers"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
+        if not 0.0 <= self.dropout < 1.0:
+            raise ValueError(f"dropout = {self.dropout!r} is out of range: allowed [0, 1)")
 
     def to_dict(self) -> dict:
-        """Plain dict (what the checkpoint stores)."""
+        """Plain dict (what the checkpoint stores).
+
+        ``lstm_layers`` and ``dropout`` are left out at their defaults, so that configs made
+        before they existed keep their checkpoint keys."""
         d = asdict(self)
         d["mlp_widths"] = list(self.mlp_widths)
+        for name, default in (("lstm_layers", 1), ("dropout", 0.0)):
+            if d[name] == default:
+                del d[name]
         return d
 
 
@@ -93,7 +111,14 @@ class SequenceModel(nn.Module):
             self.head = nn.Linear(width, c.n_outputs)
         else:
             bidirectional = c.kind == "bilstm"
-            self.body = nn.LSTM(c.n_inputs, c.hidden, batch_first=True, bidirectional=bidirectional)
+            self.body = nn.LSTM(
+                c.n_inputs,
+                c.hidden,
+                num_layers=c.lstm_layers,
+                batch_first=True,
+                bidirectional=bidirectional,
+                dropout=c.dropout,
+            )
             self.head = nn.Linear(c.hidden * (2 if bidirectional else 1), c.n_outputs)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
