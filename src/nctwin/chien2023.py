@@ -42,7 +42,6 @@ import os
 import tempfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -56,6 +55,7 @@ from .features import block_targets, chien2023_features
 from .kernel import fir
 from .machine import MachineProfile
 from .motion import Motion
+from .programs import write_programs
 from .tables import error_pct, side_by_side
 from .toolpath import MotionKind, Toolpath
 from .train import Trained
@@ -405,15 +405,3 @@ def ablation_table(rows: pd.DataFrame, models: dict[str, Trained], runs) -> pd.D
             }
         )
     return pd.DataFrame(out).round(2)
-
-
-def write_programs(texts: dict[str, str], folder: str | os.PathLike) -> list[Path]:
-    """Write programs as ``<folder>/<name>.nc`` (for a reader to open); returns the paths."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    out = []
-    for name, text in texts.items():
-        path = folder / f"{name}.nc"
-        path.write_text(text, encoding="utf-8")
-        out.append(path)
-    return out

@@ -8,9 +8,10 @@ The package is used from a clone (``pip install -e .``, as ``make`` does): shipp
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
-__all__ = ["cache_dir", "data_dir", "repo_root", "results_dir"]
+__all__ = ["atomic_write_text", "cache_dir", "data_dir", "repo_root", "results_dir"]
 
 
 def repo_root() -> Path:
@@ -31,3 +32,21 @@ def results_dir() -> Path:
 def cache_dir() -> Path:
     """Generated data, keyed by a hash of its parameters (not committed)."""
     return data_dir() / "cache"
+
+
+def atomic_write_text(path: Path, text: str) -> Path:
+    """Write ``text`` to ``path`` via a temporary file in the same folder and ``os.replace``,
+    so that an interrupted run never leaves a half-written file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

@@ -38,9 +38,7 @@ from __future__ import annotations
 import json
 import math
 import operator
-import os
 import re
-import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -455,22 +453,6 @@ class Claim:
 # Results files
 
 
-def _atomic_write_text(path: Path, text: str) -> Path:
-    """Write ``text`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
 def write_table(stem: str, name: str, df: pd.DataFrame, *, results_dir: Path | None = None) -> Path:
     """Write a reproduced table to ``results/<stem>/<name>.csv`` atomically.
 
@@ -492,7 +474,7 @@ def write_table(stem: str, name: str, df: pd.DataFrame, *, results_dir: Path | N
     """
     folder = _results_folder(stem, results_dir)
     text = df.to_csv(index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
-    return _atomic_write_text(folder / f"{_check_simple_name(name, 'name')}.csv", text)
+    return paths.atomic_write_text(folder / f"{_check_simple_name(name, 'name')}.csv", text)
 
 
 def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None = None) -> Path:
@@ -523,7 +505,7 @@ def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None
     if len(set(ids)) != len(ids):
         raise ValueError(f"claim ids must be unique, got {ids}")
     text = json.dumps(records, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
-    return _atomic_write_text(_results_folder(stem, results_dir) / "claims.json", text)
+    return paths.atomic_write_text(_results_folder(stem, results_dir) / "claims.json", text)
 
 
 def _results_folder(stem: str, folder: Path | None) -> Path:
