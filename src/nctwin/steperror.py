@@ -17,12 +17,15 @@ Convex or concave
     :math:`CC_i CC_{i+1}` chord: :math:`(c(\bar u) - \tfrac12(CC_i + CC_{i+1})) \cdot \bar n > 0`,
     with :math:`\bar n` the mean of the two end normals.
 Exact method
-    :func:`step_error_um` refines :math:`u` by golden-section search on the continuous curve,
-    all segments at once (one surface evaluation per iteration for every segment; 20 iterations
-    for the default ``xtol`` = 1e-4). The bracket shrinks to ``xtol`` of its start; at an interior
-    extreme the value error is then below :math:`\tfrac12 |d''| (\text{xtol}\,\Delta s)^2`
-    (below 1e-6 um on the paper's surfaces: :math:`|d''| \lesssim 0.05` /mm,
-    :math:`\Delta s \lesssim 1.6` mm), and an extreme at an end of the segment is exact.
+    :func:`step_error_um` refines :math:`u` on the continuous curve, all segments at once (one
+    surface evaluation per step for every segment): golden-section steps shrink the bracket to
+    ``xtol`` of the segment (10 steps for the default 1e-2), then one parabolic step through the
+    best point and its neighbours lands next to the extreme (Brent's combination, without the
+    per-segment branching). On a bracket of width :math:`w` in arc length (here
+    :math:`10^{-2} \Delta s \lesssim 0.016` mm) the vertex misses the extreme by about
+    :math:`|d'''/d''|\, w^2`, and the value by :math:`\tfrac12 |d''|` times its square: far
+    below 1e-6 um. An extreme at an end of the segment is exact. The tests compare with the
+    closed form on spheres and cylinders and with the iterative method to 1e-6 um.
 Iterative method
     :func:`step_error_iterative_um` is the straightforward alternative: a Python loop over the
     segments, each refined by scipy's bounded Brent search with scalar surface evaluations, as
@@ -87,19 +90,23 @@ def _convex(surface: Surface, seg: dict[str, np.ndarray], radius_mm: float) -> n
     return np.einsum("ij,ij->i", mid - 0.5 * (seg["cc0"] + seg["cc1"]), n_mean) > 0.0
 
 
-def step_error_um(path: ToolPath, *, xtol: float = 1e-4) -> StepError:
+def step_error_um(path: ToolPath, *, xtol: float = 1e-2) -> StepError:
     r"""Exact step error of every CL segment of ``path`` (eq. 1), vectorised.
 
-    Golden-section search for the extreme of :math:`d(u)` on :math:`[u_i, u_{i+1}]` (minimum on
-    convex segments, maximum on concave ones), run on all segments at once; the two ends of the
-    segment are candidates too (near an inflection :math:`d` can be monotone on a segment).
+    Brent-style refinement of the extreme of :math:`d(u)` on :math:`[u_i, u_{i+1}]` (minimum on
+    convex segments, maximum on concave ones), run on all segments at once: golden-section
+    steps until the bracket is ``xtol`` of the segment, then one parabolic step through the best
+    point and its two neighbours. The two ends of the segment are candidates too (near an
+    inflection :math:`d` can be monotone on a segment).
 
     Parameters
     ----------
     path : ToolPath
         ``n_lines`` lines of ``n_points`` CC/CL points.
     xtol : float
-        Final bracket width as a fraction of the segment's parameter interval, in (0, 0.1].
+        Bracket width before the parabolic step, as a fraction of the segment's parameter
+        interval, in (0, 0.1]. The default, 1e-2 (10 golden-section steps), gives errors below
+        1e-6 um on the paper's surfaces (see the module docstring).
 
     Returns
     -------
@@ -125,20 +132,30 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4) -> StepError:
     def f(u: np.ndarray) -> np.ndarray:
         return sign * _line_distance2(curve(u), seg["cl0"], axis)
 
-    a, b = seg["u0"].copy(), seg["u1"].copy()
+    a, b = seg["u0"], seg["u1"]
+    fa, fb = f(a), f(b)
+    ends_u, ends_f = (a, b), (fa, fb)
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     fc, fd = f(c), f(d)
     for _ in range(math.ceil(math.log(xtol) / math.log(_GOLDEN))):
         left = fc < fd  # the extreme is in [a, d]
-        b = np.where(left, d, b)
-        a = np.where(left, a, c)
+        a, fa = np.where(left, a, c), np.where(left, fa, fc)
+        b, fb = np.where(left, d, b), np.where(left, fd, fb)
         new = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
         fnew = f(new)
         c, d = np.where(left, new, d), np.where(left, c, new)
         fc, fd = np.where(left, fnew, fd), np.where(left, fc, fnew)
-    # the extreme may sit at an end of the segment (monotone d near an inflection)
-    candidates_u = np.stack([seg["u0"], seg["u1"], c, d])
-    candidates_f = np.stack([f(seg["u0"]), f(seg["u1"]), fc, fd])
+    # one parabolic step through the best inner point and its neighbours, kept between them
+    left = fc < fd
+    x1, x2, x3 = np.where(left, a, c), np.where(left, c, d), np.where(left, d, b)
+    f1, f2, f3 = np.where(left, fa, fc), np.where(left, fc, fd), np.where(left, fd, fb)
+    p = (x2 - x1) ** 2 * (f2 - f3) - (x2 - x3) ** 2 * (f2 - f1)
+    q = 2.0 * ((x2 - x1) * (f2 - f3) - (x2 - x3) * (f2 - f1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = x2 - p / q
+    vertex = np.where(np.isfinite(vertex) & (vertex > x1) & (vertex < x3), vertex, x2)
+    candidates_u = np.stack([*ends_u, c, d, vertex])
+    candidates_f = np.stack([*ends_f, fc, fd, f(vertex)])
     best = np.argmin(candidates_f, axis=0)
     u_star = np.take_along_axis(candidates_u, best[None], axis=0)[0]
     length = np.sqrt(sign * np.take_along_axis(candidates_f, best[None], axis=0)[0])

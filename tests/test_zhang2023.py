@@ -1,0 +1,51 @@
+"""The Zhang et al. 2023 experiment helpers: split, histograms with the paper's bins, metrics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nctwin import zhang2023 as zh
+from nctwin.tables import load_paper_table
+
+
+def test_split_is_seeded_disjoint_and_sized() -> None:
+    picked, rest = zh.split(19_800, 0.15, seed=0)
+    assert len(picked) == 2970 and len(rest) == 16_830  # the paper's Table 4, test set 5
+    assert len(np.union1d(picked, rest)) == 19_800
+    again, _ = zh.split(19_800, 0.15, seed=0)
+    np.testing.assert_array_equal(picked, again)
+    assert not np.array_equal(picked, zh.split(19_800, 0.15, seed=1)[0])
+    assert len(zh.split(19_800, 0.0, seed=0)[0]) == 0
+    with pytest.raises(ValueError, match="share"):
+        zh.split(10, 1.5, seed=0)
+
+
+def test_histogram_uses_the_papers_bins_and_counts_beyond_the_last() -> None:
+    paper = load_paper_table("zhang2023_table3")
+    exact = np.array([1.0, 2.0, 4.0, 10.0, 10.0])
+    predicted = exact + np.array([0.05, 0.15, 0.45, 0.9, -2.5])
+    table = zh.error_histogram(predicted, exact, paper)
+    absolute = table[table.metric == "abs_err"].set_index("bin_label")["count"]
+    # by hand: 0.05 -> "< 0.1", 0.15 -> "0.1-0.2", 0.45 -> "0.4-0.5", 0.9 and 2.5 -> "> 0.8"
+    assert absolute.to_dict() == {
+        "< 0.1": 1, "0.1-0.2": 1, "0.2-0.3": 0, "0.3-0.4": 0, "0.4-0.5": 1, "0.5-0.8": 0,
+        "> 0.8": 2,
+    }  # fmt: skip
+    relative = table[table.metric == "rel_err"].set_index("bin_label")["count"]
+    # 5 %, 7.5 %, 11.25 %, 9 %, 25 %
+    assert relative.to_dict() == {
+        "< 1%": 0, "1-5%": 0, "5-10%": 3, "10-15%": 1, "15-20%": 0, "> 20%": 1,
+    }  # fmt: skip
+    assert table.loc[table.bin_label == "< 0.1", "paper_count"].item() == 3616
+    assert table.groupby("metric")["ratio_pct"].sum().round(9).eq(100.0).all()
+
+
+def test_transfer_metrics_by_hand() -> None:
+    m = zh.transfer_metrics(np.array([1.0, 2.5, 3.0, 0.2]), np.array([1.5, 2.0, 1.0, 0.2]))
+    assert m == {"max_abs_err_um": 2.0, "share_below_1um_pct": 75.0, "mean_abs_err_um": 0.75}
+
+
+def test_variant_rejects_bad_epochs() -> None:
+    with pytest.raises(ValueError, match="epochs"):
+        zh.variant_configs(325, epochs=0)
