@@ -87,3 +87,17 @@ def test_bad_parameters_raise() -> None:
     with pytest.raises(ValueError, match="momentum"):
         TrainConfig(momentum=1.0)
     assert "optimiser" not in TrainConfig().to_dict()  # default keys of old checkpoints unchanged
+
+
+def test_dropout_training_repeats_bit_for_bit_and_leaves_the_global_rng_alone() -> None:
+    xs, ys = _rows()
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.5, weight_init="uniform")
+    torch.manual_seed(123)
+    before = torch.random.get_rng_state()
+    a = fit(config, CFG, xs, ys, cache=False, progress=False)
+    assert torch.equal(torch.random.get_rng_state(), before)
+    torch.rand(5)  # a different global state must not matter
+    b = fit(config, CFG, xs, ys, cache=False, progress=False)
+    assert a.history == b.history
+    for pa, pb in zip(a.model.parameters(), b.model.parameters(), strict=True):
+        assert torch.equal(pa, pb)

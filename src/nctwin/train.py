@@ -21,7 +21,9 @@ Windows
     window of context on either side), which is also what makes it fast (:meth:`Trained.predict`).
 Determinism
     The initial weights, the window offsets and the batch order are drawn from generators seeded
-    with ``seed``; :func:`fit` runs with ``torch.use_deterministic_algorithms(True)`` and one
+    with ``seed``, and so are dropout masks (torch's global generator, seeded with ``seed``
+    inside :func:`torch.random.fork_rng`, so the caller's random state is untouched); :func:`fit`
+    runs with ``torch.use_deterministic_algorithms(True)`` and one
     intra-op thread (``torch.set_num_threads(1)``: summation order, hence rounding, depends on the
     thread count), and restores both settings when it returns. The same data and configs give
     the same weights, bit for bit, on one machine.
@@ -337,7 +339,11 @@ def fit(
             split = (np.arange(n), np.arange(n, len(xs)))
         else:
             split = _split(len(xs), train_config)
-        trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
+        # dropout masks come from torch's global generator: seed it inside a forked state, so
+        # training repeats bit for bit and the caller's random state is left as it was
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(train_config.seed)
+            trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     finally:
         torch.set_num_threads(threads)
         torch.use_deterministic_algorithms(deterministic)
