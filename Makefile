@@ -36,7 +36,7 @@ export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean FORCE
+        clean distclean linuxcnc FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> notebooks (papermill) -> book; prints the HTML path"
@@ -44,6 +44,7 @@ help:
 	@echo "make venv        create/refresh .venv from requirements.txt (skipped when up to date)"
 	@echo "make mathjax     local MathJax $(MATHJAX_VERSION) (npm) into $(MATHJAX_DIR)"
 	@echo "make chromium    install Debian chromium if $(CHROMIUM) is missing"
+	@echo "make linuxcnc    install LinuxCNC (uspace) + libfaketime and the RTAPI_UID user, if missing"
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
@@ -103,6 +104,35 @@ chromium:
 	echo "chromium: installing Debian chromium with apt-get"; \
 	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q; \
 	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium
+
+# ---------------------------------------------------------------------------------------------
+# linuxcnc: the real NC kernel of nctwin.kernel.linuxcnc. Debian packages without recommends
+# (the full install pulls a real-time kernel and PyQt5): linuxcnc-uspace (planner, HAL,
+# halsampler, the `linuxcnc` module of /usr/bin/python3), libfaketime (runs it faster than real
+# time), iproute2 (loopback in the private network namespace). As root LinuxCNC needs RTAPI_UID,
+# an unprivileged user: LINUXCNC_USER must equal nctwin.kernel.linuxcnc.RTAPI_USER.
+LINUXCNC_USER := linuxcnc-rt
+LINUXCNC_PKGS := linuxcnc-uspace libfaketime iproute2
+linuxcnc:
+	@have() { [ -x /usr/bin/linuxcnc ] && [ -x /usr/bin/halsampler ] && [ -x /usr/sbin/ip ] && \
+	  compgen -G '/usr/lib/*/faketime/libfaketimeMT.so.1' >/dev/null; }; \
+	if have && id -u $(LINUXCNC_USER) >/dev/null 2>&1; then echo "linuxcnc: present"; exit 0; fi; \
+	sudo=; [ "$$(id -u)" = 0 ] || sudo=sudo; t0=$$(date +%s); \
+	if ! have; then \
+	  echo "linuxcnc: installing $(LINUXCNC_PKGS) with apt-get (about 1 min)"; \
+	  if ! { $$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q && \
+	         $$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
+	           --no-install-recommends $(LINUXCNC_PKGS); }; then \
+	    echo "linuxcnc: FAILED to install $(LINUXCNC_PKGS) with apt-get (Debian bookworm" \
+	         "packages; needs root or sudo and the network); see apt-get's message above" >&2; \
+	    exit 1; \
+	  fi; \
+	fi; \
+	if ! id -u $(LINUXCNC_USER) >/dev/null 2>&1; then \
+	  $$sudo useradd --system --no-create-home --shell /usr/sbin/nologin $(LINUXCNC_USER); \
+	  echo "linuxcnc: created user $(LINUXCNC_USER) (RTAPI_UID)"; \
+	fi; \
+	echo "linuxcnc: ready in $$(( $$(date +%s) - t0 )) s"
 
 # ---------------------------------------------------------------------------------------------
 # notebooks: papermill, headless, cwd = repo root (notebooks write results/<stem>/...). The output

@@ -1,0 +1,132 @@
+"""LinuxCNC as the measured machine (nctwin.kernel.linuxcnc).
+
+The INI tests run everywhere; the live tests record short programs on LinuxCNC and are skipped
+where it cannot run (``make linuxcnc`` installs it). Expected values are derived by hand: LinuxCNC
+has no jerk limit, so a straight line from rest to rest with a trapezoidal feed profile takes
+``L / F + F / A``.
+"""
+
+import glob
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from nctwin.gcode import parse
+from nctwin.kernel import linuxcnc as lc
+from nctwin.machine import load_machine
+
+MACHINE = load_machine("linuxcnc_sim")
+PERIOD_S = MACHINE.period_s
+#: halsampler prints positions with 6 decimals (1 nm): speeds from differences carry up to
+#: 2e-6 mm / 1 ms of rounding.
+SPEED_ROUNDING_MM_S = 2e-6 / PERIOD_S
+
+LINE = "G21 G90 G61\nG1 X60 F3000\nM2\n"  # 60 mm at 50 mm/s along X
+CORNER = "G21 G90 G61\nG1 X30 F3000\nY20\nM2\n"  # exact stop at a 90 degree corner
+
+live = pytest.mark.skipif(lc.available() is not None, reason=f"LinuxCNC: {lc.available()}")
+
+
+def _ini_values(text: str) -> dict[tuple[str, str], str]:
+    out, section = {}, ""
+    for raw in text.splitlines():
+        if raw.startswith("["):
+            section = raw.strip("[]")
+        elif "=" in raw and not raw.startswith("#"):
+            key, value = (s.strip() for s in raw.split("=", 1))
+            out[section, key] = value
+    return out
+
+
+def test_ini_holds_the_profile_limits():
+    ini = _ini_values(lc.ini_text(MACHINE))
+    for i, axis in enumerate("XYZ"):
+        for section in (f"AXIS_{axis}", f"JOINT_{i}"):
+            v = float(ini[section, "MAX_VELOCITY"])
+            a = float(ini[section, "MAX_ACCELERATION"])
+            assert v == MACHINE.axis_max_velocity_mm_s[i]
+            assert a == MACHINE.axis_max_acceleration_mm_s2[i]
+    assert float(ini["TRAJ", "MAX_LINEAR_VELOCITY"]) == 200.0 == MACHINE.max_feed_mm_s
+    assert float(ini["TRAJ", "MAX_LINEAR_ACCELERATION"]) == 1000.0
+    assert float(ini["TRAJ", "DEFAULT_LINEAR_VELOCITY"]) == 50.0
+    assert ini["TRAJ", "NO_FORCE_HOMING"] == "1"
+    assert ini["KINS", "KINEMATICS"] == "trivkins coordinates=XYZ"
+    assert int(ini["EMCMOT", "SERVO_PERIOD"]) == 1_000_000
+    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"].endswith("G64 P0.0254")
+    assert not any(key.startswith("ARC_BLEND") for _, key in ini)
+
+
+def test_profile_linuxcnc_cannot_follow_is_rejected():
+    from dataclasses import replace
+
+    with pytest.raises(ValueError, match="axis_max_jerk_mm_s3"):
+        lc.ini_text(replace(MACHINE, axis_max_jerk_mm_s3=(1e4, 1e4, 1e4)))
+    with pytest.raises(ValueError, match="rapid_feed_mm_s"):
+        lc.ini_text(replace(MACHINE, rapid_feed_mm_s=100.0))
+
+
+@pytest.mark.parametrize(("kw", "name"), [({"speed": 50}, "speed"), ({"timeout_s": 0}, "timeout")])
+def test_bad_run_arguments(kw, name):
+    with pytest.raises(ValueError, match=name):
+        lc.record(LINE, MACHINE, **kw)
+
+
+@pytest.fixture(scope="module")
+def line_motion():
+    return lc.run(LINE, MACHINE)
+
+
+@live
+def test_straight_line_duration_end_and_feed(line_motion):
+    m = line_motion
+    length_mm, feed_mm_s, acc_mm_s2 = 60.0, 50.0, 1000.0
+    expected_s = length_mm / feed_mm_s + feed_mm_s / acc_mm_s2  # 1.25 s
+    assert abs(m.cycle_time_s - expected_s) <= 3 * PERIOD_S
+    np.testing.assert_array_equal(m.pos_mm[-1], [60.0, 0.0, 0.0])
+    np.testing.assert_array_equal(m.pos_mm[0], [0.0, 0.0, 0.0])
+    assert m.speed_mm_s.max() <= feed_mm_s + SPEED_ROUNDING_MM_S
+    # cruise at F, reached after F / A
+    assert m.speed_mm_s.max() >= feed_mm_s - SPEED_ROUNDING_MM_S
+    acc_rounding_mm_s2 = SPEED_ROUNDING_MM_S / PERIOD_S
+    assert np.abs(m.acc_mm_s2[:, 0]).max() <= acc_mm_s2 * (1 + 1e-6) + acc_rounding_mm_s2
+    assert (m.block == 0).all()
+
+
+@live
+def test_trace_is_the_same_at_real_time(line_motion):
+    """The planner's output does not depend on wall-clock time: x1 equals x5, bit for bit."""
+    slow = lc.run(LINE, MACHINE, speed=1)
+    np.testing.assert_array_equal(slow.pos_mm, line_motion.pos_mm)
+
+
+@live
+def test_exact_stop_at_corner():
+    tp = parse(CORNER)
+    m = lc.run(tp, MACHINE)
+    corner = np.flatnonzero((m.pos_mm[:, 0] == 30.0) & (m.pos_mm[:, 1] == 0.0))
+    assert len(corner) >= 1  # the tool reaches the corner itself: no blend
+    k = corner[0]
+    # one servo period at the axis acceleration is 1 mm/s: the speed passes through ~0
+    assert m.speed_mm_s[k - 1 : k + 2].min() <= 1000.0 * PERIOD_S
+    assert (m.block[: k - 5] == 0).all() and (m.block[k + 5 :] == 1).all()
+    np.testing.assert_array_equal(m.pos_mm[-1], [30.0, 20.0, 0.0])
+    assert m.speed_mm_s.max() <= 50.0 + SPEED_ROUNDING_MM_S
+
+
+@live
+def test_rejected_program_carries_linuxcnc_message():
+    with pytest.raises(lc.LinuxCNCError, match="exceed X's positive limit") as info:
+        lc.run("G21 G90\nG1 X20000 F600\nM2\n", MACHINE)
+    assert info.value.line == 2
+    assert isinstance(info.value, ValueError)
+
+
+@live
+def test_timeout_kills_the_instance_and_leaves_nothing():
+    pattern = str(Path(tempfile.gettempdir()) / "nctwin-linuxcnc-*")
+    before = set(glob.glob(pattern))
+    with pytest.raises(TimeoutError, match="timeout_s"):
+        lc.record("G21\nG4 P60\nM2\n", MACHINE, timeout_s=4.0)
+    assert set(glob.glob(pattern)) <= before
