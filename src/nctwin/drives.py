@@ -225,6 +225,8 @@ class FeedDriveMachine:
         Noise of the recorded motor currents.
     velocity_noise_mm_s : float
         Noise of the recorded velocities.
+    velocity_resolution_mm_s : float
+        Quantisation of the recorded velocities (a standing axis reads 0).
     position_resolution_mm : float
         Quantisation of the recorded positions.
     dynamometer_noise_n : float
@@ -238,7 +240,8 @@ class FeedDriveMachine:
     servo_rate_hz: float = 5000.0
     record_rate_hz: float = 250.0
     current_noise_a: float = 0.01
-    velocity_noise_mm_s: float = 0.02
+    velocity_noise_mm_s: float = 0.01
+    velocity_resolution_mm_s: float = 0.05
     position_resolution_mm: float = 1e-4
     dynamometer_noise_n: float = 2.0
     dynamometer_cutoff_hz: float = 300.0
@@ -255,7 +258,7 @@ class FeedDriveMachine:
         _check("dynamometer_cutoff_hz", self.dynamometer_cutoff_hz, 0.0,
                0.5 * self.servo_rate_hz, low_open=True)  # fmt: skip
         for name in ("current_noise_a", "velocity_noise_mm_s", "position_resolution_mm",
-                     "dynamometer_noise_n"):  # fmt: skip
+                     "velocity_resolution_mm_s", "dynamometer_noise_n"):  # fmt: skip
             _check(name, getattr(self, name), 0.0, 1e3)
 
     @property
@@ -400,6 +403,8 @@ def simulate_drives(
     res = machine.position_resolution_mm
     pos = np.round(rec_s / res) * res if res > 0 else rec_s
     vel = rec_v + machine.velocity_noise_mm_s * rng.standard_normal(rec_v.shape)
+    v_res = machine.velocity_resolution_mm_s
+    vel = np.round(vel / v_res) * v_res if v_res > 0 else vel
     current = rec_f / par["km_n_a"] + machine.current_noise_a * rng.standard_normal(rec_f.shape)
     t = np.arange(n_r) * decim * dt
     acc_rec = np.gradient(vel, t, axis=1) if n_r > 1 else np.zeros_like(vel)
