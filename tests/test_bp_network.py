@@ -101,3 +101,15 @@ def test_dropout_training_repeats_bit_for_bit_and_leaves_the_global_rng_alone() 
     assert a.history == b.history
     for pa, pb in zip(a.model.parameters(), b.model.parameters(), strict=True):
         assert torch.equal(pa, pb)
+
+
+def test_a_diverging_training_raises_a_clear_error() -> None:
+    from nctwin.train import TrainingDivergedError
+
+    xs, ys = _rows()
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.0, weight_init="normal",
+                      weight_std=50.0)  # fmt: skip
+    cfg = TrainConfig(seed=0, max_epochs=5, patience=5, batch_size=10, window_lines=8,
+                      learning_rate=10.0, loss="mse", optimiser="sgd", momentum=0.8)  # fmt: skip
+    with pytest.raises(TrainingDivergedError, match="diverged"):
+        fit(config, cfg, xs, ys, cache=False, progress=False)

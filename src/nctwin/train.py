@@ -54,7 +54,18 @@ from tqdm import tqdm
 from . import paths
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
-__all__ = ["Scaler", "TrainConfig", "Trained", "fit", "load_checkpoint"]
+__all__ = [
+    "Scaler",
+    "TrainConfig",
+    "Trained",
+    "TrainingDivergedError",
+    "fit",
+    "load_checkpoint",
+]
+
+
+class TrainingDivergedError(RuntimeError):
+    """Raised by :func:`fit` when no epoch had a finite validation loss."""
 
 
 @dataclass(frozen=True)
@@ -418,6 +429,11 @@ def _train(
             if stale >= cfg.patience:
                 break
     bar.close()
+    if best_state is None:
+        raise TrainingDivergedError(
+            f"{path.stem}: the validation loss was never finite (the training diverged); "
+            f"learning_rate = {cfg.learning_rate!r} may be too large"
+        )
     model.load_state_dict(best_state)
     model.eval()
     return Trained(

@@ -44,13 +44,14 @@ from .steperror import (
     step_error_um,
 )
 from .surfaces import ToolPath, iso_parametric_path, paper_surface
-from .train import TrainConfig, Trained, fit
+from .train import TrainConfig, Trained, TrainingDivergedError, fit
 
 __all__ = [
     "HIDDEN",
     "SurfaceData",
     "TransferRun",
     "best_time_s",
+    "dropout_sweep",
     "error_histogram",
     "finetune_configs",
     "paper_configs",
@@ -205,6 +206,52 @@ def scaled_mse(trained: Trained, x: np.ndarray, y_um: np.ndarray) -> float:
     (eq. 4 and 7; what Table 2 and Fig. 5 report), evaluation mode (no dropout)."""
     z = (predict_um(trained, x) - y_um) / trained.y_scaler.std[0]
     return float(np.mean(z * z))
+
+
+def dropout_sweep(
+    data: SurfaceData,
+    train_rows: np.ndarray,
+    test_rows: np.ndarray,
+    probabilities: tuple[float, ...],
+    *,
+    epochs: int,
+    seed: int,
+    progress: bool = True,
+) -> pd.DataFrame:
+    """Table 2: the variant trained with each dropout probability.
+
+    Returns
+    -------
+    DataFrame
+        ``dropout_p``, ``final_train_mse`` (last epoch, dropout active), ``test_mse`` (dropout
+        off; both Z-scored), ``share_below_1um_pct`` and ``diverged`` (the training loss became
+        NaN in every epoch; the numbers are then NaN).
+    """
+    rows = []
+    for p in probabilities:
+        model_cfg, train_cfg = variant_configs(
+            data.x.shape[1], epochs=epochs, dropout=p, seed=seed
+        )
+        row = {"dropout_p": p, "final_train_mse": np.nan, "test_mse": np.nan,
+               "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
+        try:
+            net = train(
+                data, train_rows, model_cfg, train_cfg, name=f"zhang2023_sweep_p{p:g}",
+                progress=progress,
+            )  # fmt: skip
+        except TrainingDivergedError:
+            rows.append(row)
+            continue
+        y = data.exact.error_um[test_rows]
+        pred = predict_um(net, data.x[test_rows])
+        row.update(
+            final_train_mse=net.history["train"][-1],
+            test_mse=scaled_mse(net, data.x[test_rows], y),
+            share_below_1um_pct=transfer_metrics(pred, y)["share_below_1um_pct"],
+            diverged=False,
+        )
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def _bins(paper: pd.DataFrame, metric: str) -> list[tuple[str, float, float]]:
