@@ -25,6 +25,7 @@ SPEED_ROUNDING_MM_S = 2e-6 / PERIOD_S
 
 LINE = "G21 G90 G61\nG1 X60 F3000\nM2\n"  # 60 mm at 50 mm/s along X
 CORNER = "G21 G90 G61\nG1 X30 F3000\nY20\nM2\n"  # exact stop at a 90 degree corner
+BLENDED = "G21 G90 G64 P0.05\nG1 X20 F6000\nX30 Y5\nY20\nX0 Y0\nM2\n"
 
 live = pytest.mark.skipif(lc.available() is not None, reason=f"LinuxCNC: {lc.available()}")
 
@@ -54,7 +55,7 @@ def test_ini_holds_the_profile_limits():
     assert ini["TRAJ", "NO_FORCE_HOMING"] == "1"
     assert ini["KINS", "KINEMATICS"] == "trivkins coordinates=XYZ"
     assert int(ini["EMCMOT", "SERVO_PERIOD"]) == 1_000_000
-    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"].endswith("G64 P0.0254")
+    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"].endswith("G64 P0.0254 Q0")
     assert not any(key.startswith("ARC_BLEND") for _, key in ini)
 
 
@@ -71,6 +72,12 @@ def test_profile_linuxcnc_cannot_follow_is_rejected():
 def test_bad_run_arguments(kw, name):
     with pytest.raises(ValueError, match=name):
         lc.record(LINE, MACHINE, **kw)
+
+
+def test_program_without_motion_needs_no_linuxcnc():
+    m = lc.run("G21 G90\nG1 X0 F600\nM2\n", MACHINE)
+    assert len(m) == 1 and m.cycle_time_s == 0.0
+    np.testing.assert_array_equal(m.pos_mm, [[0.0, 0.0, 0.0]])
 
 
 @pytest.fixture(scope="module")
@@ -95,10 +102,13 @@ def test_straight_line_duration_end_and_feed(line_motion):
 
 
 @live
-def test_trace_is_the_same_at_real_time(line_motion):
-    """The planner's output does not depend on wall-clock time: x1 equals x5, bit for bit."""
-    slow = lc.run(LINE, MACHINE, speed=1)
-    np.testing.assert_array_equal(slow.pos_mm, line_motion.pos_mm)
+def test_trace_does_not_depend_on_wall_clock_time():
+    """Blended corners need the planner's look-ahead: x1 equals x5, bit for bit."""
+    fast = lc.run(BLENDED, MACHINE, speed=5)
+    slow = lc.run(BLENDED, MACHINE, speed=1)
+    np.testing.assert_array_equal(slow.pos_mm, fast.pos_mm)
+    np.testing.assert_array_equal(slow.block, fast.block)
+    assert fast.block[-1] == 3 and (np.diff(fast.block) >= 0).all()
 
 
 @live

@@ -5,8 +5,8 @@ LinuxCNC starts this script as ``DISPLAY`` program with ``-ini INIFILE``; it run
 Python (``/usr/bin/python3``), where LinuxCNC's ``linuxcnc`` module lives, never inside nctwin.
 In the folder of the INI file it reads ``program.ngc``, records the sampler's FIFO with
 ``halsampler -t`` into ``samples.txt`` while the program runs, and writes ``result.json``:
-``{"ok": true}`` or ``{"ok": false, "message": "<LinuxCNC's error>"}``. When it exits,
-LinuxCNC shuts down.
+``{"ok": true}``, ``{"ok": false, "message": "<LinuxCNC's error>"}`` or, if LinuxCNC did not carry
+out a command in time, ``{"ok": false, "stuck": "<what>"}``. When it exits, LinuxCNC shuts down.
 """
 
 import json
@@ -24,14 +24,24 @@ POLL_S = 0.005
 TAIL_S = 0.05
 #: Longest wait for LinuxCNC to accept a command (s).
 COMMAND_TIMEOUT_S = 10.0
-#: Wait for a program run (s): in effect none.
-RUN_TIMEOUT_S = 1e9
+#: Task states that wait for the held motion (or for I/O or a delay behind it).
+TASK_WAITING = (
+    linuxcnc.EXEC_WAITING_FOR_MOTION,
+    linuxcnc.EXEC_WAITING_FOR_MOTION_QUEUE,
+    linuxcnc.EXEC_WAITING_FOR_MOTION_AND_IO,
+    linuxcnc.EXEC_WAITING_FOR_IO,
+    linuxcnc.EXEC_WAITING_FOR_DELAY,
+)
 #: Error-channel kinds that abort the run (operator text and display messages do not).
 ERROR_KINDS = (linuxcnc.NML_ERROR, linuxcnc.OPERATOR_ERROR)
 
 
 class Rejected(Exception):
     """LinuxCNC reported an error."""
+
+
+class Stuck(Exception):
+    """LinuxCNC did not carry out a command in time."""
 
 
 def check_errors(errors):
@@ -45,12 +55,27 @@ def check_errors(errors):
             raise Rejected(text)
 
 
-def command(cmd, errors, call, *args, timeout_s=COMMAND_TIMEOUT_S):
+def command(cmd, errors, call, *args):
     """Send one command and wait until task has completed it."""
     getattr(cmd, call)(*args)
-    if cmd.wait_complete(timeout_s) == -1:
-        raise Rejected(f"LinuxCNC did not complete {call}{args} within {timeout_s} s")
+    if cmd.wait_complete(COMMAND_TIMEOUT_S) == -1:
+        raise Stuck(f"LinuxCNC did not complete {call}{args} within {COMMAND_TIMEOUT_S} s")
     check_errors(errors)
+
+
+def release(cmd, stat, errors):
+    """Set both overrides back to 1 while the program runs (task completes no command then)."""
+    cmd.feedrate(1.0)
+    cmd.rapidrate(1.0)
+    deadline = time.monotonic() + COMMAND_TIMEOUT_S
+    while True:
+        check_errors(errors)
+        stat.poll()
+        if stat.feedrate == 1.0 and stat.rapidrate == 1.0:
+            return
+        if time.monotonic() > deadline:
+            raise Stuck(f"LinuxCNC did not set the overrides to 1 within {COMMAND_TIMEOUT_S} s")
+        time.sleep(POLL_S)
 
 
 def run(folder):
@@ -62,9 +87,28 @@ def run(folder):
     with open(os.path.join(folder, "samples.txt"), "w") as out:
         sampler = subprocess.Popen(["halsampler", "-t"], stdout=out)
         try:
-            # task completes AUTO_RUN when the interpreter is done: no time limit here, the
-            # caller kills the instance when its own timeout is reached
-            command(cmd, errors, "auto", linuxcnc.AUTO_RUN, 0, timeout_s=RUN_TIMEOUT_S)
+            # Hold the motion (overrides at 0) until the interpreter has queued the whole
+            # program or filled the queue: otherwise the planner starts with whatever the
+            # interpreter has read so far, and its look-ahead depends on wall-clock time.
+            command(cmd, errors, "feedrate", 0.0)
+            command(cmd, errors, "rapidrate", 0.0)
+            # Task completes AUTO_RUN only when the program has run. It passes the interpreted
+            # moves to the planner's queue one per task cycle; while the motion is held it ends
+            # up waiting (for the motion: at the program's end, a dwell or a queue buster; or
+            # for room in a full queue). Only a program without motion or dwell goes back to
+            # idle (if that happens between two polls, the caller's timeout ends the run).
+            cmd.auto(linuxcnc.AUTO_RUN, 0)
+            started = False
+            while True:
+                check_errors(errors)
+                stat.poll()
+                if stat.exec_state in TASK_WAITING:
+                    break
+                if started and stat.interp_state == linuxcnc.INTERP_IDLE:
+                    break
+                started = started or stat.interp_state != linuxcnc.INTERP_IDLE
+                time.sleep(POLL_S)
+            release(cmd, stat, errors)
             while True:
                 check_errors(errors)
                 stat.poll()
@@ -85,6 +129,8 @@ def main():
         result = {"ok": True}
     except Rejected as exc:
         result = {"ok": False, "message": str(exc)}
+    except Stuck as exc:
+        result = {"ok": False, "stuck": str(exc)}
     with open(os.path.join(folder, "result.json"), "w") as fh:
         json.dump(result, fh)
 

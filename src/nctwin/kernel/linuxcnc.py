@@ -12,8 +12,10 @@ How a run works
   ``[AXIS_*]``/``[JOINT_*]`` limits from the axis limits, ``[TRAJ]`` ``MAX_LINEAR_VELOCITY`` =
   ``max_feed_mm_s``, ``MAX_LINEAR_ACCELERATION`` = the largest axis acceleration, no
   ``ARC_BLEND_*`` settings (LinuxCNC's defaults), no homing, start at X0 Y0 Z0, and the startup
-  code ``G21 G90 G64 P<blend_tol_mm>``, so a program that sets no ``G61``/``G64`` blends within the
-  profile's tolerance. A plain ``G64`` (no P) means P0 on LinuxCNC: no tolerance.
+  code ``G21 G90 G64 P<blend_tol_mm> Q0``, so a program that sets no ``G61``/``G64`` blends within
+  the profile's tolerance without merging segments (LinuxCNC's own default is ``G64 P0.0254 Q0``;
+  a ``G64 P`` without Q sets Q = P, which turns on its naive-CAM detector). A plain ``G64`` (no
+  P) means P0 on LinuxCNC: no tolerance.
 * Each run gets its own folder and private namespaces (``unshare``: PID, mount, IPC, network):
   the folder is the instance's ``/tmp`` and ``HOME``, ``/dev/shm`` is a fresh tmpfs. Instances
   never see each other's lock file, shared memory or NML port, and nothing is left behind; when
@@ -23,7 +25,11 @@ How a run works
 * The ``DISPLAY`` program is ``_linuxcnc_display.py``, run by the system Python (where LinuxCNC's
   ``linuxcnc`` module lives): it runs the program and records HAL's ``sampler`` (``axis.*.pos-cmd``,
   ``motion.current-vel``, ``motion.program-line``, ``motion.in-position``) every servo period
-  with ``halsampler``. This module only writes and reads files, so nctwin imports without LinuxCNC.
+  with ``halsampler``. It holds the motion (feed and rapid overrides at 0) until the interpreter
+  has queued the whole program (or filled the planner's queue), so the planner's look-ahead never
+  depends on how fast the interpreter ran: traces repeat bit for bit, at any speed-up up to 5
+  and on a busy machine. This module only writes and reads files, so nctwin imports without
+  LinuxCNC.
 
 Conventions of the returned motion: ``pos_mm`` is the commanded position (``pos-cmd``), the first
 sample is the last one at rest before the tool moves, the last the first one at rest after it
@@ -51,7 +57,7 @@ import numpy as np
 from ..gcode import GCodeError, dump, parse
 from ..machine import MachineProfile
 from ..motion import Motion
-from ..toolpath import Toolpath
+from ..toolpath import MotionKind, Toolpath
 
 __all__ = [
     "LinuxCNCError",
@@ -159,7 +165,7 @@ def ini_text(machine: MachineProfile) -> str:
         f"CYCLE_TIME = {machine.period_s!r}",
         "[RS274NGC]",
         f"PARAMETER_FILE = {d}/sim.var",
-        f"RS274NGC_STARTUP_CODE = G21 G90 G64 P{machine.blend_tol_mm!r}",
+        f"RS274NGC_STARTUP_CODE = G21 G90 G64 P{machine.blend_tol_mm!r} Q0",
         "[EMCMOT]",
         "EMCMOT = motmod",
         "COMM_TIMEOUT = 1.0",
@@ -292,7 +298,8 @@ def record(
     LinuxCNCUnavailable
         If LinuxCNC cannot run here (see :func:`available`).
     TimeoutError
-        If the run takes longer than ``timeout_s``.
+        If the run takes longer than ``timeout_s``, or LinuxCNC does not carry out a command
+        within 10 s.
     """
     _check_run_args(timeout_s, speed)
     ini = ini_text(machine)
@@ -346,6 +353,8 @@ def record(
                 "LinuxCNC did not run the program; its output:\n" + console[-4000:]
             )
         result = json.loads(result_file.read_text())
+        if "stuck" in result:
+            raise TimeoutError(f"{result['stuck']}; the instance was shut down")
         if not result["ok"]:
             raise _rejected(result["message"], program)
         samples = _read_samples(folder / "samples.txt")
@@ -415,7 +424,8 @@ def run(
     -------
     Motion
         Samples every servo period from rest to rest; ``block`` indexes the Toolpath's blocks
-        (of ``parse(program)`` for text).
+        (of ``parse(program)`` for text). A program without motion or dwell gives one sample at
+        X0 Y0 Z0 without starting LinuxCNC.
 
     Raises
     ------
@@ -435,7 +445,12 @@ def run(
             f"toolpath_or_program = {type(toolpath_or_program).__name__} is not allowed: "
             "allowed a Toolpath or G-code text (str)"
         )
+    _check_run_args(timeout_s, speed)
     tp = parse(text)
+    if not ((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL)).any():
+        # nothing moves: one sample at LinuxCNC's start position, without starting it
+        z = np.zeros((1, 3))
+        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), machine.period_s)
     rec = record(text, machine, timeout_s=timeout_s, speed=speed)
     return motion_of(rec, tp)
 
