@@ -36,7 +36,7 @@ export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean linuxcnc FORCE
+        clean distclean linuxcnc record FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> notebooks (papermill) -> book; prints the HTML path"
@@ -45,6 +45,7 @@ help:
 	@echo "make mathjax     local MathJax $(MATHJAX_VERSION) (npm) into $(MATHJAX_DIR)"
 	@echo "make chromium    install Debian chromium if $(CHROMIUM) is missing"
 	@echo "make linuxcnc    install LinuxCNC (uspace) + libfaketime and the RTAPI_UID user, if missing"
+	@echo "make record      re-record data/recordings/linuxcnc/ on LinuxCNC (needs make linuxcnc)"
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
@@ -133,6 +134,11 @@ linuxcnc:
 	  echo "linuxcnc: created user $(LINUXCNC_USER) (RTAPI_UID)"; \
 	fi; \
 	echo "linuxcnc: ready in $$(( $$(date +%s) - t0 )) s"
+
+# record: the shipped LinuxCNC recordings (nctwin.recordings), re-recorded from nothing.
+record: venv linuxcnc
+	@t0=$$(date +%s); $(PY) -m nctwin.recordings; \
+	echo "record: done in $$(( $$(date +%s) - t0 )) s"
 
 # ---------------------------------------------------------------------------------------------
 # notebooks: papermill, headless, cwd = repo root (notebooks write results/<stem>/...). The output
