@@ -156,8 +156,13 @@ class Scaler:
         return cls(mean, np.where(std > 0, std, 1.0), tuple(log_columns))
 
     def transform(self, x: np.ndarray) -> np.ndarray:
-        """Scaled copy of ``x`` (N, n_columns), float32."""
-        return ((_log(x, self.log_columns) - self.mean) / self.std).astype(np.float32)
+        """Scaled copy of ``x`` (N, n_columns), float32 (computed in float64, in place)."""
+        if self.log_columns:
+            z = _log(x, self.log_columns) - self.mean
+        else:
+            z = np.subtract(x, self.mean, dtype=np.float64)
+        z /= self.std
+        return z.astype(np.float32)
 
     def inverse(self, z: np.ndarray) -> np.ndarray:
         """Undo :meth:`transform` (float64)."""
