@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -20,3 +21,16 @@ def shared_programs() -> Path:
     if not SHARED_PROGRAMS.is_dir():
         pytest.skip("../shared/programs is not beside this clone")
     return SHARED_PROGRAMS
+
+
+@pytest.fixture
+def linuxcnc_live() -> None:
+    """Skip a live LinuxCNC test where LinuxCNC cannot run, or fail it where
+    ``NCTWIN_REQUIRE_LINUXCNC=1`` (``make test``: the real kernel is proven, not assumed)."""
+    from nctwin.kernel.linuxcnc import available
+
+    why = available()
+    if why and os.environ.get("NCTWIN_REQUIRE_LINUXCNC") == "1":
+        pytest.fail(f"NCTWIN_REQUIRE_LINUXCNC=1 but LinuxCNC cannot run: {why}")
+    if why:
+        pytest.skip(f"LinuxCNC: {why}")

@@ -27,7 +27,7 @@ LINE = "G21 G90 G61\nG1 X60 F3000\nM2\n"  # 60 mm at 50 mm/s along X
 CORNER = "G21 G90 G61\nG1 X30 F3000\nY20\nM2\n"  # exact stop at a 90 degree corner
 BLENDED = "G21 G90 G64 P0.05\nG1 X20 F6000\nX30 Y5\nY20\nX0 Y0\nM2\n"
 
-live = pytest.mark.skipif(lc.available() is not None, reason=f"LinuxCNC: {lc.available()}")
+live = pytest.mark.usefixtures("linuxcnc_live")
 
 
 def _ini_values(text: str) -> dict[tuple[str, str], str]:
@@ -80,14 +80,9 @@ def test_program_without_motion_needs_no_linuxcnc():
     np.testing.assert_array_equal(m.pos_mm, [[0.0, 0.0, 0.0]])
 
 
-@pytest.fixture(scope="module")
-def line_motion():
-    return lc.run(LINE, MACHINE)
-
-
 @live
-def test_straight_line_duration_end_and_feed(line_motion):
-    m = line_motion
+def test_straight_line_duration_end_and_feed():
+    m = lc.run(LINE, MACHINE)
     length_mm, feed_mm_s, acc_mm_s2 = 60.0, 50.0, 1000.0
     expected_s = length_mm / feed_mm_s + feed_mm_s / acc_mm_s2  # 1.25 s
     assert abs(m.cycle_time_s - expected_s) <= 3 * PERIOD_S

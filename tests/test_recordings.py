@@ -10,7 +10,6 @@ import pytest
 
 from nctwin import recordings
 from nctwin.gcode import parse
-from nctwin.kernel import linuxcnc as lc
 from nctwin.machine import load_machine
 
 SHIPPED = recordings.load_recordings()
@@ -45,7 +44,7 @@ def test_shipped_recording_is_consistent(name):
     assert rec.cycle_time_s >= (tp.lengths_mm / tp.feed_mm_s).sum() - 1e-9
 
 
-@pytest.mark.skipif(lc.available() is not None, reason=f"LinuxCNC: {lc.available()}")
+@pytest.mark.usefixtures("linuxcnc_live")
 @pytest.mark.parametrize("name", LIVE)
 def test_live_recording_equals_shipped(name):
     shipped = SHIPPED[name]
