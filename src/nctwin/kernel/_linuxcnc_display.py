@@ -24,13 +24,11 @@ POLL_S = 0.005
 TAIL_S = 0.05
 #: Longest wait for LinuxCNC to accept a command (s).
 COMMAND_TIMEOUT_S = 10.0
-#: Task states that wait for the held motion (or for I/O or a delay behind it).
-TASK_WAITING = (
+#: Task states that wait for the (held) motion.
+WAITING_FOR_MOTION = (
     linuxcnc.EXEC_WAITING_FOR_MOTION,
     linuxcnc.EXEC_WAITING_FOR_MOTION_QUEUE,
     linuxcnc.EXEC_WAITING_FOR_MOTION_AND_IO,
-    linuxcnc.EXEC_WAITING_FOR_IO,
-    linuxcnc.EXEC_WAITING_FOR_DELAY,
 )
 #: Error-channel kinds that abort the run (operator text and display messages do not).
 ERROR_KINDS = (linuxcnc.NML_ERROR, linuxcnc.OPERATOR_ERROR)
@@ -93,16 +91,17 @@ def run(folder):
             command(cmd, errors, "feedrate", 0.0)
             command(cmd, errors, "rapidrate", 0.0)
             # Task completes AUTO_RUN only when the program has run. It passes the interpreted
-            # moves to the planner's queue one per task cycle; while the motion is held it ends
-            # up waiting (for the motion: at the program's end, a dwell or a queue buster; or
-            # for room in a full queue). Only a program without motion or dwell goes back to
-            # idle (if that happens between two polls, the caller's timeout ends the run).
+            # moves to the planner's queue a few per task cycle; while the motion is held and
+            # moves are queued, it ends up waiting for the motion (at the program's end or a
+            # queue buster), or the queue is full. Waits for I/O are passing. Only a program
+            # without motion goes back to idle (if that happens between two polls, the caller's
+            # timeout ends the run).
             cmd.auto(linuxcnc.AUTO_RUN, 0)
             started = False
             while True:
                 check_errors(errors)
                 stat.poll()
-                if stat.exec_state in TASK_WAITING:
+                if stat.queue_full or (stat.queue > 0 and stat.exec_state in WAITING_FOR_MOTION):
                     break
                 if started and stat.interp_state == linuxcnc.INTERP_IDLE:
                     break
