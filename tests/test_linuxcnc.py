@@ -107,6 +107,35 @@ def test_trace_does_not_depend_on_wall_clock_time():
 
 
 @live
+def test_parallel_instances_do_not_interfere():
+    """Three instances at once (private lock file, shared memory, NML port, HOME each)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(3) as pool:
+        line, a, b = pool.map(lambda p: lc.run(p, MACHINE), [LINE, BLENDED, BLENDED])
+    np.testing.assert_array_equal(a.pos_mm, b.pos_mm)
+    assert abs(line.cycle_time_s - (60.0 / 50.0 + 50.0 / 1000.0)) <= 3 * PERIOD_S
+    np.testing.assert_array_equal(line.pos_mm[-1], [60.0, 0.0, 0.0])
+
+
+@live
+def test_program_longer_than_the_planner_queue():
+    """2400 chords of 0.05 mm (the queue holds about 1800 moves): nothing lost, repeatable."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    phi = np.arange(1, 2401) * 0.05 / 20.0  # chords on a circle of radius 20 mm
+    xy = np.round(20.0 * np.column_stack([np.sin(phi), 1.0 - np.cos(phi)]), 4)
+    program = "G21 G90 G64 P0.01 Q0\nG1 F6000\n" + "".join(f"X{x} Y{y}\n" for x, y in xy)
+    with ThreadPoolExecutor(2) as pool:
+        a, b = pool.map(lambda p: lc.run(p, MACHINE), [program, program])
+    np.testing.assert_array_equal(a.pos_mm, b.pos_mm)
+    np.testing.assert_array_equal(a.pos_mm[-1], [xy[-1, 0], xy[-1, 1], 0.0])
+    assert a.block[-1] == len(xy) - 1
+    assert a.speed_mm_s.max() <= 100.0 + SPEED_ROUNDING_MM_S
+    assert a.cycle_time_s >= len(xy) * 0.05 / 100.0
+
+
+@live
 def test_exact_stop_at_corner():
     tp = parse(CORNER)
     m = lc.run(tp, MACHINE)
