@@ -20,6 +20,8 @@ How a run works
   the folder is the instance's ``/tmp`` and ``HOME``, ``/dev/shm`` is a fresh tmpfs. Instances
   never see each other's lock file, shared memory or NML port, and nothing is left behind; when
   the run ends or times out, killing the namespace's first process ends every process in it.
+  Namespaces need root (as in CI). If the calling Python process itself is killed, the instance
+  runs its program to the end and its folder (``$TMPDIR/nctwin-linuxcnc-*``) stays.
 * LinuxCNC runs in POSIX non-realtime mode (no RT kernel; the planner's output is the same) and,
   through libfaketime, ``speed`` times faster than real time.
 * The ``DISPLAY`` program is ``_linuxcnc_display.py``, run by the system Python (where LinuxCNC's
@@ -28,8 +30,10 @@ How a run works
   with ``halsampler``. It holds the motion (feed and rapid overrides at 0) until the interpreter
   has queued the whole program (or filled the planner's queue), so the planner's look-ahead never
   depends on how fast the interpreter ran: traces repeat bit for bit, at any speed-up up to 5
-  and on a busy machine. This module only writes and reads files, so nctwin imports without
-  LinuxCNC.
+  and on a busy machine. After a queue buster in the middle of a program (a dwell, an M-code that
+  waits) the motion restarts as soon as the next move is queued, as on the real control; such
+  programs may not repeat bit for bit. This module only writes and reads files, so nctwin
+  imports without LinuxCNC.
 
 Conventions of the returned motion: ``pos_mm`` is the commanded position (``pos-cmd``), the first
 sample is the last one at rest before the tool moves, the last the first one at rest after it
