@@ -2,8 +2,9 @@
 
 LinuxCNC (:mod:`nctwin.kernel.linuxcnc`) is the measured machine. Its recordings of paper 1's
 training programs (:func:`nctwin.programs.training.training_specs`, F 65-100 mm/s,
-G64 P 0.05-0.5 mm) are shipped as a measurement, the way a paper's data set would be, so that
-chapters use them without LinuxCNC. ``make record`` re-records them from nothing (it needs
+G64 P 0.05-0.5 mm) and test programs (toolpaths I and II, the pocket; F 75 and 92 mm/s,
+G64 P 0.3 and 0.4 mm) are shipped as a measurement, the way a paper's data set would be, so
+that chapters use them without LinuxCNC. ``make record`` re-records them from nothing (it needs
 ``make linuxcnc``); :func:`load_recordings` reads them.
 
 One compressed file per program, ``data/recordings/linuxcnc/<name>.npz``, with
@@ -33,7 +34,8 @@ from .gcode import parse
 from .machine import MachineProfile, load_machine
 from .motion import Motion
 from .paths import data_dir
-from .programs.training import ProgramSpec, training_specs
+from .programs.pocket import pocket_program
+from .programs.training import contour_program, training_specs
 
 __all__ = [
     "MACHINE",
@@ -43,7 +45,7 @@ __all__ = [
     "record_program",
     "record_set",
     "recording_dir",
-    "recording_specs",
+    "recording_programs",
     "trace_sha256",
 ]
 
@@ -57,6 +59,9 @@ N_PROGRAMS = 6
 N_LINES = 200
 FEED_RANGE_MM_S = (65.0, 100.0)
 TOL_RANGE_MM = (0.05, 0.5)
+#: Feeds and tolerances of the test programs (those of the Chien chapter's test set).
+TEST_FEEDS_MM_S = (75.0, 92.0)
+TEST_TOLS_MM = (0.3, 0.4)
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,7 +71,7 @@ class RecordedProgram:
     Parameters
     ----------
     name : str
-        File stem, e.g. ``train_00_mixed``.
+        File stem, e.g. ``train_00_mixed`` or ``test_II_F92_P0.3``.
     program : str
         G-code text that was run.
     machine : str
@@ -135,8 +140,8 @@ def recording_dir() -> Path:
     return data_dir() / "recordings" / "linuxcnc"
 
 
-def recording_specs() -> dict[str, ProgramSpec]:
-    """The shipped set: name -> training program spec (see the module docstring)."""
+def recording_programs() -> dict[str, str]:
+    """The shipped set: name -> G-code text (see the module docstring)."""
     specs = training_specs(
         RECORD_SEED,
         n_programs=N_PROGRAMS,
@@ -144,7 +149,17 @@ def recording_specs() -> dict[str, ProgramSpec]:
         feed_range_mm_s=FEED_RANGE_MM_S,
         tol_range_mm=TOL_RANGE_MM,
     )
-    return {f"train_{i:02d}_{s.family}": s for i, s in enumerate(specs)}
+    out = {f"train_{i:02d}_{s.family}": s.text() for i, s in enumerate(specs)}
+    for name in ("I", "II", "pocket"):
+        for f in TEST_FEEDS_MM_S:
+            for e in TEST_TOLS_MM:
+                text = (
+                    pocket_program(feed_mm_s=f, tol_mm=e)
+                    if name == "pocket"
+                    else contour_program(name, feed_mm_s=f, tol_mm=e)
+                )
+                out[f"test_{name}_F{f:g}_P{e:g}"] = text
+    return out
 
 
 def trace_sha256(motion: Motion) -> str:
@@ -179,7 +194,7 @@ def record_program(
 def record_set(
     folder: Path | None = None, *, n_jobs: int = 2, speed: float = 5
 ) -> list[RecordedProgram]:
-    """Record every program of :func:`recording_specs` and save them into ``folder``.
+    """Record every program of :func:`recording_programs` and save them into ``folder``.
 
     Parameters
     ----------
@@ -194,11 +209,11 @@ def record_set(
         raise ValueError(f"n_jobs = {n_jobs!r} is out of range: allowed integers >= 1")
     folder = recording_dir() if folder is None else Path(folder)
     machine = load_machine(MACHINE)
-    specs = recording_specs()
-    jobs = (delayed(record_program)(n, s.text(), machine, speed=speed) for n, s in specs.items())
+    programs = recording_programs()
+    jobs = (delayed(record_program)(n, t, machine, speed=speed) for n, t in programs.items())
     parallel = Parallel(n_jobs=n_jobs, backend="threading", return_as="generator")
     out = []
-    for rec in tqdm(parallel(jobs), total=len(specs), desc="LinuxCNC", mininterval=5.0):
+    for rec in tqdm(parallel(jobs), total=len(programs), desc="LinuxCNC", mininterval=5.0):
         rec.save(folder)
         out.append(rec)
     return out
