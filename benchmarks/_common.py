@@ -3,24 +3,16 @@
 from __future__ import annotations
 
 import json
-import time
-from collections.abc import Callable
+from functools import partial
 from pathlib import Path
+
+from nctwin.checks import best_time_s as _best_time_s
+
+#: Benchmarks repeat more than the package's default: shortest of 15 runs after 2 warm-ups.
+best_time_s = partial(_best_time_s, repeat=15, warmup=2)
 
 #: Public programs beside the clone (absent in a user's clone).
 SHARED_PROGRAMS = Path(__file__).resolve().parents[2] / "shared" / "programs"
-
-
-def best_time_s(fn: Callable[[], object], *, repeat: int = 15, warmup: int = 2) -> float:
-    """Shortest wall time of ``fn()`` over ``repeat`` runs, after ``warmup`` runs."""
-    for _ in range(warmup):
-        fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def record(benchmark: str, value: float, unit: str, target: str) -> None:

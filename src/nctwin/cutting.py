@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .checks import check_range
+
 __all__ = [
     "C45",
     "CuttingCoefficients",
@@ -41,13 +43,6 @@ __all__ = [
     "tool_forces",
     "workpiece_forces",
 ]
-
-
-def _check(name: str, value: float, low: float, high: float = np.inf, *, low_open=False) -> None:
-    ok = (value > low if low_open else value >= low) and value <= high
-    if not ok:
-        bracket = "(" if low_open else "["
-        raise ValueError(f"{name} = {value!r} is out of range: allowed {bracket}{low}, {high}]")
 
 
 @dataclass(frozen=True)
@@ -78,11 +73,11 @@ class EndMill:
     disc_mm: float = 0.25
 
     def __post_init__(self) -> None:
-        _check("diameter_mm", self.diameter_mm, 0.0, low_open=True)
-        _check("teeth", self.teeth, 1)
-        _check("helix_deg", self.helix_deg, 0.0, 60.0)
-        _check("runout_mm", self.runout_mm, 0.0, 0.1)
-        _check("disc_mm", self.disc_mm, 0.0, 5.0, low_open=True)
+        check_range("diameter_mm", self.diameter_mm, 0.0, low_open=True)
+        check_range("teeth", self.teeth, 1)
+        check_range("helix_deg", self.helix_deg, 0.0, 60.0)
+        check_range("runout_mm", self.runout_mm, 0.0, 0.1)
+        check_range("disc_mm", self.disc_mm, 0.0, 5.0, low_open=True)
 
     @property
     def radius_mm(self) -> float:
@@ -110,7 +105,7 @@ class CuttingCoefficients:
 
     def __post_init__(self) -> None:
         for name in ("ktc_n_mm2", "krc_n_mm2", "kac_n_mm2", "kte_n_mm", "kre_n_mm", "kae_n_mm"):
-            _check(name, getattr(self, name), 0.0, 1e5)
+            check_range(name, getattr(self, name), 0.0, 1e5)
 
 
 #: C45 (AISI 1045) carbon steel with a coated carbide end mill: values of the order Altintas
@@ -134,7 +129,7 @@ def immersion(ae_mm: float, radius_mm: float, mode: str) -> tuple[float, float]:
     -------
     (phi_start_rad, phi_exit_rad)
     """
-    _check("ae_mm", ae_mm, 0.0, 2.0 * radius_mm, low_open=True)
+    check_range("ae_mm", ae_mm, 0.0, 2.0 * radius_mm, low_open=True)
     if mode not in ("up", "down"):
         raise ValueError(f"mode = {mode!r} is unknown: allowed up, down")
     if ae_mm >= 2.0 * radius_mm:
@@ -185,7 +180,7 @@ def tool_forces(
     torque_nmm : ndarray, shape (T,)
         Cutting torque about the spindle axis, :math:`R \\sum dF_t`.
     """
-    _check("spindle_rpm", spindle_rpm, 0.0, 1e5, low_open=True)
+    check_range("spindle_rpm", spindle_rpm, 0.0, 1e5, low_open=True)
     if not 0.0 <= phi_start_rad < phi_exit_rad <= np.pi:
         raise ValueError(
             f"phi_start_rad, phi_exit_rad = {phi_start_rad!r}, {phi_exit_rad!r} are out of "

@@ -52,6 +52,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 
+from .checks import check_range
+
 __all__ = [
     "AxisDrive",
     "DriveRecord",
@@ -63,13 +65,6 @@ __all__ = [
     "simulate_drives",
     "spindle_signals",
 ]
-
-
-def _check(name: str, value: float, low: float, high: float = np.inf, *, low_open=False) -> None:
-    ok = (value > low if low_open else value >= low) and value <= high
-    if not ok:
-        bracket = "(" if low_open else "["
-        raise ValueError(f"{name} = {value!r} is out of range: allowed {bracket}{low}, {high}]")
 
 
 @dataclass(frozen=True)
@@ -142,11 +137,11 @@ class AxisDrive:
         for name in ("own_mass_kg", "km_n_a", "pole_pitch_mm", "stribeck_mm_s", "stribeck_shape",
                      "bristle_stiffness_n_mm", "friction_wavelength_mm", "kv_1_s",
                      "velocity_bandwidth_hz", "integral_time_s"):  # fmt: skip
-            _check(name, getattr(self, name), 0.0, 1e7, low_open=True)
+            check_range(name, getattr(self, name), 0.0, 1e7, low_open=True)
         for name in ("restoring_n_mm", "coulomb_n", "viscous_n_s_mm", "bristle_damping_n_s_mm"):
-            _check(name, getattr(self, name), 0.0, 1e7)
-        _check("breakaway_n", self.breakaway_n, self.coulomb_n, 1e7)
-        _check("friction_position_share", self.friction_position_share, 0.0, 0.49)
+            check_range(name, getattr(self, name), 0.0, 1e7)
+        check_range("breakaway_n", self.breakaway_n, self.coulomb_n, 1e7)
+        check_range("friction_position_share", self.friction_position_share, 0.0, 0.49)
         if len(self.cogging_n) != len(self.cogging_phase_rad):
             raise ValueError(
                 f"cogging_phase_rad has {len(self.cogging_phase_rad)} entries: allowed "
@@ -180,10 +175,10 @@ class Spindle:
     speed_noise_rpm: float = 1.0
 
     def __post_init__(self) -> None:
-        _check("kt_nm_a", self.kt_nm_a, 0.0, 1e3, low_open=True)
+        check_range("kt_nm_a", self.kt_nm_a, 0.0, 1e3, low_open=True)
         for name in ("friction_nm", "viscous_nm_per_rpm", "droop_rpm_per_nm",
                      "current_noise_a", "speed_noise_rpm"):  # fmt: skip
-            _check(name, getattr(self, name), 0.0, 1e3)
+            check_range(name, getattr(self, name), 0.0, 1e3)
 
 
 def _default_axes() -> tuple[AxisDrive, AxisDrive, AxisDrive]:
@@ -247,19 +242,19 @@ class FeedDriveMachine:
     dynamometer_cutoff_hz: float = 300.0
 
     def __post_init__(self) -> None:
-        _check("servo_rate_hz", self.servo_rate_hz, 100.0, 1e5)
-        _check("record_rate_hz", self.record_rate_hz, 1.0, self.servo_rate_hz)
+        check_range("servo_rate_hz", self.servo_rate_hz, 100.0, 1e5)
+        check_range("record_rate_hz", self.record_rate_hz, 1.0, self.servo_rate_hz)
         ratio = self.servo_rate_hz / self.record_rate_hz
         if abs(ratio - round(ratio)) > 1e-9:
             raise ValueError(
                 f"record_rate_hz = {self.record_rate_hz!r} is out of range: allowed divisors of "
                 f"servo_rate_hz = {self.servo_rate_hz!r}"
             )
-        _check("dynamometer_cutoff_hz", self.dynamometer_cutoff_hz, 0.0,
+        check_range("dynamometer_cutoff_hz", self.dynamometer_cutoff_hz, 0.0,
                0.5 * self.servo_rate_hz, low_open=True)  # fmt: skip
         for name in ("current_noise_a", "velocity_noise_mm_s", "position_resolution_mm",
                      "velocity_resolution_mm_s", "dynamometer_noise_n"):  # fmt: skip
-            _check(name, getattr(self, name), 0.0, 1e3)
+            check_range(name, getattr(self, name), 0.0, 1e3)
 
     @property
     def decimation(self) -> int:

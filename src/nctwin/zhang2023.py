@@ -30,12 +30,12 @@ Configurations
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 
+from .checks import best_time_s
 from .models import BPConfig
 from .steperror import (
     StepError,
@@ -154,9 +154,7 @@ def variant_configs(
     return model, train_config
 
 
-def finetune_configs(
-    n_inputs: int, *, epochs: int, seed: int = 0
-) -> tuple[BPConfig, TrainConfig]:
+def finetune_configs(n_inputs: int, *, epochs: int, seed: int = 0) -> tuple[BPConfig, TrainConfig]:
     """Fine-tuning settings: :func:`variant_configs` without dropout, a tenth of its learning
     rate (1e-3) and ``epochs`` epochs (the paper gives no fine-tuning settings)."""
     model, train_config = variant_configs(n_inputs, epochs=epochs, dropout=0.0, seed=seed)
@@ -229,9 +227,7 @@ def dropout_sweep(
     """
     rows = []
     for p in probabilities:
-        model_cfg, train_cfg = variant_configs(
-            data.x.shape[1], epochs=epochs, dropout=p, seed=seed
-        )
+        model_cfg, train_cfg = variant_configs(data.x.shape[1], epochs=epochs, dropout=p, seed=seed)
         row = {"dropout_p": p, "final_train_mse": np.nan, "test_mse": np.nan,
                "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
         try:
@@ -366,9 +362,7 @@ def transfer(
             )  # fmt: skip
         else:
             tuned = start
-        runs.append(
-            TransferRun(data.index, pct, tuned, rest, predict_um(tuned, data.x[rest]))
-        )
+        runs.append(TransferRun(data.index, pct, tuned, rest, predict_um(tuned, data.x[rest])))
     return runs
 
 
@@ -391,14 +385,3 @@ def transfer_table(runs: list[TransferRun], data: dict[int, SurfaceData], paper:
             }
         )
     return pd.DataFrame(rows)
-
-
-def best_time_s(fn, *, repeat: int = 5) -> float:
-    """Shortest wall time of ``fn()`` over ``repeat`` runs (after one warm-up run)."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
