@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+import torch
 
 from nctwin import zhang2023 as zh
+from nctwin.models import BPConfig, build_bp
 from nctwin.tables import load_paper_table
+from nctwin.train import Scaler, TrainConfig, Trained
 
 
 def test_split_is_seeded_disjoint_and_sized() -> None:
@@ -49,3 +54,30 @@ def test_transfer_metrics_by_hand() -> None:
 def test_variant_rejects_bad_epochs() -> None:
     with pytest.raises(ValueError, match="epochs"):
         zh.variant_configs(325, epochs=0)
+
+
+def _network(x: np.ndarray, y: np.ndarray) -> Trained:
+    config = BPConfig(n_inputs=x.shape[1], weight_init="uniform")
+    model = build_bp(config, generator=torch.Generator().manual_seed(1)).eval()
+    return Trained(
+        model, Scaler.fit([x]), Scaler.fit([y]), TrainConfig(), {}, 0, 0.0, Path("untrained.pt")
+    )
+
+
+def test_folded_prediction_is_the_networks_prediction() -> None:
+    # coordinates far from 0 with small spreads, as the Table 1 samples: Z-score matters
+    rng = np.random.default_rng(0)
+    x = rng.normal(80.0, 1.0, (500, 13)) + rng.normal(0.0, 30.0, (1, 13))
+    y = rng.uniform(0.0, 10.0, (500, 1))
+    net = _network(x, y)
+    pred = zh.predict_um(net, x)
+    assert pred.shape == (500,)
+    # the same network as Trained.predict (float32 scaled inputs), rounded differently
+    np.testing.assert_allclose(pred, net.predict(x)[:, 0], rtol=0, atol=1e-5)
+    # by hand, all in float64: W (x - mean) / std + b, then the other layers
+    with torch.no_grad():
+        z = torch.from_numpy((x - net.x_scaler.mean) / net.x_scaler.std)
+        by_hand = net.y_scaler.inverse(net.model.double()(z).numpy())[:, 0]
+    np.testing.assert_allclose(pred, by_hand, rtol=0, atol=1e-5)
+    with pytest.raises(ValueError, match="shape"):
+        zh.predict_um(net, x[:, :12])
