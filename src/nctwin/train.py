@@ -316,7 +316,8 @@ def fit(
     cache : bool
         Load a checkpoint with the same data and configs if present; save the result.
     progress : bool
-        Show a tqdm bar over epochs.
+        Show a tqdm bar over epochs, from 5 s into the training on, unless the environment sets
+        ``TQDM_DISABLE=1`` (for headless runs).
     validation : (xs, ys), optional
         Programs to validate on, given explicitly (e.g. half of a pocket, Sun et al. 2022,
         Table 2); then every program of ``xs``/``ys`` trains and ``val_share`` is not used.
@@ -401,12 +402,15 @@ def _train(
     ty = [zy[i] for i in train_idx]
     history: dict[str, list[float]] = {"train": [], "val": []}
     best, best_state, best_epoch, stale = math.inf, None, 0, 0
+    # shown after 5 s only, so that short runs leave no text in executed notebooks; ``disable``
+    # is passed only to hide it, so that TQDM_DISABLE=1 in the environment hides it too
     bar = tqdm(
         range(1, cfg.max_epochs + 1),
         desc=path.stem,
-        disable=not progress,
         leave=False,
         mininterval=5.0,
+        delay=5.0,
+        **({} if progress else {"disable": True}),
     )
     for epoch in bar:
         model.train()
