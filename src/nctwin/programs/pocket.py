@@ -1,11 +1,28 @@
-"""A contour-parallel pocketing program: the kind of test path of Chien et al. (2023, Fig. 8).
+"""A contour-parallel pocket around an island, as a CAM system writes it: the pocketing test path
+of Chien et al. (2023, Fig. 8-9, after Endo & Sencer 2022).
 
-The pocket outline is a rectangle with two rounded and two sharp corners. The tool cuts it from
-the inside out along contour-parallel offsets (one every ``stepover_mm``): straight edges are
-single long G-lines (local blends at the sharp corners), rounded corners are discretised into
-short G-lines of about ``segment_mm`` (global blends), and a short G1 link steps from one offset
-to the next. Offsetting a rounded corner inward shrinks its radius until it becomes sharp, so the
-inner offsets have more local and fewer global blends, as a real pocket does.
+The part: a pocket whose outline (:data:`OUTLINE_MM`) is a polygon with sharp corners, small
+corner fillets, a chamfer and one large-radius corner, and an island (a boss) that follows the
+outline at a distance :data:`BAND_MM`, so the floor to clear is a band of constant width between
+two walls. The tool (radius ``tool_radius_mm``) clears the band with contour-parallel offsets:
+
+* **Offsets.** At every level :math:`d` (the tool centre's distance from the nearest wall) there
+  are two rings: the outline offset inward by :math:`d` (straight walls stay single long G-lines;
+  a convex fillet of radius :math:`r` becomes :math:`r - d`, sharp once :math:`d \\ge r`) and the
+  island offset outward by :math:`d` (its sharp corners become arcs of radius :math:`d`, its
+  fillets grow). The levels are evenly spaced from ``tool_radius_mm`` at both walls to the middle
+  of the band, at most ``stepover_mm`` apart.
+* **Corner clean-up.** Where the outline has a sharp convex corner, the band is wider along the
+  corner's bisector than across it: a floor region in the corner is more than half the band from
+  both walls. The levels beyond the middle there are small closed loops (two offset walls and an
+  arc about the island's corner); the middle ring cuts them as it passes the corner, going out
+  along the bisector loop by loop and back.
+* **Order and links.** Inside out, climb milling: level by level from the middle of the band to
+  the walls, the island's ring clockwise and the outline's ring counter-clockwise. Every ring
+  starts and ends on the bottom wall; straight G1 links across material already cleared join
+  them (stay-down linking), so the program is one chain of feed moves at one depth.
+* **Arcs** (fillets, the arcs of the island's offsets) are written as chords within
+  ``chord_tol_mm`` of the arc, as a CAM post-processor that outputs only G1 does.
 """
 
 from __future__ import annotations
@@ -14,99 +31,217 @@ import math
 
 import numpy as np
 
-__all__ = ["pocket_program"]
+from ..checks import check_range
+
+__all__ = ["BAND_MM", "OUTLINE_MM", "pocket_program", "pocket_rings"]
+
+#: Outline of the pocket's wall, counter-clockwise: vertices (mm) and the fillet radius of each
+#: corner (0: sharp). A 5 mm fillet bottom-left, a sharp corner bottom-right, a chamfer of two
+#: sharp 135-degree corners top-right, a shallow boss reaching into the pocket from the top wall
+#: (6 mm fillets at its foot, 15 mm at its two reflex corners), a large 70 mm round top-left and
+#: a 12 mm fillet where the slanted wall meets the left side. Edge 0 (the bottom wall) is
+#: horizontal: every ring starts on it.
+OUTLINE_MM = (
+    ((0.0, 0.0), 5.0),
+    ((230.0, 0.0), 0.0),
+    ((230.0, 120.0), 0.0),
+    ((200.0, 150.0), 0.0),
+    ((170.0, 150.0), 6.0),
+    ((148.0, 140.0), 15.0),
+    ((117.0, 140.0), 15.0),
+    ((95.0, 150.0), 6.0),
+    ((60.0, 150.0), 70.0),
+    ((0.0, 100.0), 12.0),
+)
+#: Width of the floor between the outline and the island (mm); the island is the outline offset
+#: inward by this distance (its corners sharp where the outline's fillet is smaller).
+BAND_MM = 42.0
 
 
-def _contour(half_w: float, half_h: float, radius: float, segment: float) -> np.ndarray:
-    """Closed outline, counter-clockwise from the middle of the bottom edge, shape (n, 2).
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
-    Corners at (+w, -h) and (-w, +h) are rounded with ``radius`` (sharp when it is 0); the other
-    two are sharp. The first point is repeated at the end.
+
+def _offset(vertices: np.ndarray, radii: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray]:
+    """Offset a counter-clockwise polygon with corner fillets by ``d`` to its inside (``d < 0``:
+    outside). Every edge moves by ``d``; a convex corner's fillet becomes ``r - d``, a reflex one's
+    ``r + d`` (0: sharp), so a sharp corner offset outward becomes an arc of radius ``-d``.
+
+    Returns the vertices, shape (m, 2), and radii, shape (m,), of the offset polygon.
     """
-    pts = [(0.0, -half_h)]
-    corners = [
-        ((half_w, -half_h), 0.0, True),
-        ((half_w, half_h), 0.5 * math.pi, False),
-        ((-half_w, half_h), math.pi, True),
-        ((-half_w, -half_h), 1.5 * math.pi, False),
-    ]
-    for (cx, cy), start, rounded in corners:
-        if rounded and radius > 0:
-            # centre inside the corner; the arc turns 90 degrees counter-clockwise
-            ox, oy = cx - math.copysign(radius, cx), cy - math.copysign(radius, cy)
-            n = max(2, math.ceil(0.5 * math.pi * radius / segment))
-            phi = start - 0.5 * math.pi + np.linspace(0, 0.5 * math.pi, n + 1)
-            pts += list(zip(ox + radius * np.cos(phi), oy + radius * np.sin(phi), strict=True))
-        else:
-            pts.append((cx, cy))
-    pts.append(pts[0])
+    u = _unit(np.roll(vertices, -1, axis=0) - vertices)  # edge i: vertex i -> i + 1
+    n = np.column_stack([-u[:, 1], u[:, 0]])  # inward normal of a ccw polygon
+    p = vertices + d * n
+    u_in, p_in = np.roll(u, 1, axis=0), np.roll(p, 1, axis=0)  # the edge arriving at vertex i
+    # vertex i: intersection of the offset edges i - 1 and i
+    cross = u_in[:, 0] * u[:, 1] - u_in[:, 1] * u[:, 0]
+    w = p - p_in
+    s = (w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]) / cross
+    convex = cross > 0
+    return p_in + s[:, None] * u_in, np.maximum(np.where(convex, radii - d, radii + d), 0.0)
+
+
+def _ring(
+    vertices: np.ndarray,
+    radii: np.ndarray,
+    start: np.ndarray,
+    chord_tol: float,
+    excursions: dict[int, list[np.ndarray]] | None = None,
+) -> np.ndarray:
+    """Points of a closed counter-clockwise ring, from ``start`` (a point on edge 0 -> 1) around
+    and back: straight edges as one segment, fillets as chords within ``chord_tol``. At a sharp
+    vertex ``i`` of ``excursions``, the tool cuts those loops (each from and back to its first
+    point) and returns to the vertex.
+
+    Raises ValueError where a fillet does not fit on its edges (the offset has collapsed)."""
+    m = len(vertices)
+    u = _unit(np.roll(vertices, -1, axis=0) - vertices)
+    u_in = np.roll(u, 1, axis=0)
+    turn = np.arctan2(u_in[:, 0] * u[:, 1] - u_in[:, 1] * u[:, 0], (u_in * u).sum(axis=1))
+    tangent = radii * np.tan(0.5 * np.abs(turn))  # from the vertex to the fillet's ends
+    edge = np.linalg.norm(np.roll(vertices, -1, axis=0) - vertices, axis=1)
+    if (tangent + np.roll(tangent, -1) > edge + 1e-9).any():
+        raise ValueError("the offset has collapsed: a fillet no longer fits on its edges")
+    pts = [start]
+    for i in [*range(1, m), 0]:
+        v, r = vertices[i], radii[i]
+        if r == 0:
+            pts.append(v)
+            if excursions and i in excursions:
+                pts += [p for loop in excursions[i] for p in loop] + [v]
+            continue
+        a = v - u_in[i] * tangent[i]
+        normal = np.sign(turn[i]) * np.array([-u_in[i, 1], u_in[i, 0]])
+        centre = a + r * normal
+        phi0 = math.atan2(a[1] - centre[1], a[0] - centre[0])
+        n = max(1, math.ceil(abs(turn[i]) / (2 * math.acos(max(1 - chord_tol / r, -1.0)))))
+        phi = phi0 + turn[i] * np.linspace(0.0, 1.0, n + 1)
+        pts += list(centre + r * np.column_stack([np.cos(phi), np.sin(phi)]))
+    pts.append(start)
     return np.array(pts)
+
+
+def _corner_loop(
+    vertices: np.ndarray, i: int, island_vertex: np.ndarray, d: float, chord_tol: float
+) -> np.ndarray | None:
+    """The clean-up loop at level ``d`` in the sharp corner ``i`` of the offset outline
+    ``vertices``, or None where the level does not reach into the corner: from the corner back
+    along the arriving wall, around the island's corner (an arc of radius ``d`` about it) and
+    back along the leaving wall, shape (n, 2)."""
+    m = len(vertices)
+    corner = vertices[i]
+    w = corner - island_vertex
+    if np.linalg.norm(w) <= d:
+        return None
+    ends = []
+    for other in (vertices[(i - 1) % m], vertices[(i + 1) % m]):  # each wall meets the circle
+        e = _unit(other - corner)
+        b = e @ w
+        ends.append(corner + (-b - math.sqrt(max(b * b - (w @ w - d * d), 0.0))) * e)
+    a0, a1 = (math.atan2(p[1] - island_vertex[1], p[0] - island_vertex[0]) for p in ends)
+    sweep = (a0 - a1 + math.pi) % (2 * math.pi) - math.pi  # the short way round the island
+    n = max(1, math.ceil(abs(sweep) / (2 * math.acos(max(1 - chord_tol / d, -1.0)))))
+    phi = a0 - sweep * np.linspace(0.0, 1.0, n + 1)
+    arc = island_vertex + d * np.column_stack([np.cos(phi), np.sin(phi)])
+    return np.vstack([corner, arc, corner])
+
+
+def pocket_rings(
+    *, tool_radius_mm: float = 4.0, stepover_mm: float = 2.0, chord_tol_mm: float = 0.001
+) -> list[np.ndarray]:
+    """The tool-centre path of the pocket as closed polylines in cutting order (island and
+    outline ring per level, middle out; the first outline ring with the corner loops), each
+    shape (n_i, 2).
+
+    See the module docstring; the parameters are those of :func:`pocket_program`.
+    """
+    verts = np.array([p for p, _ in OUTLINE_MM])
+    radii = np.array([r for _, r in OUTLINE_MM])
+    island = _offset(verts, radii, BAND_MM)
+    width = BAND_MM - 2 * tool_radius_mm
+    n_levels = math.ceil(width / stepover_mm) + 1  # positions across the band, walls included
+    step = width / (n_levels - 1)
+    levels = tool_radius_mm + step * np.arange((n_levels + 1) // 2)[::-1]  # middle first
+    x_start = 0.4 * verts[1, 0]
+    half = 0.5 * BAND_MM
+    # corner loops beyond the middle, in the outline's corners where the island's is sharp
+    corners = np.flatnonzero(island[1] == 0)
+    loops: dict[int, list[np.ndarray]] = {int(i): [] for i in corners}
+    d = levels[0] + step
+    while True:
+        offset = _offset(verts, radii, d)
+        found = False
+        for i in corners:
+            loop = _corner_loop(offset[0], i, island[0][i], d, chord_tol_mm)
+            if loop is not None and offset[1][i] == 0:
+                loops[int(i)].append(loop)
+                found = True
+        if not found:
+            break
+        d += step
+    rings = []
+    for k, d in enumerate(levels):
+        if d < half - 0.25 * step:  # the middle level is cut once, by the outline's ring
+            poly = _offset(*island, -d)
+            rings.append(_ring(*poly, np.array([x_start, poly[0][0, 1]]), chord_tol_mm)[::-1])
+        poly = _offset(verts, radii, d)
+        start = np.array([x_start, poly[0][0, 1]])
+        rings.append(_ring(*poly, start, chord_tol_mm, loops if k == 0 else None))
+    return rings
 
 
 def pocket_program(
     *,
-    width_mm: float = 260.0,
-    height_mm: float = 190.0,
-    corner_radius_mm: float = 85.0,
-    stepover_mm: float = 2.5,
-    segment_mm: float = 0.9,
     feed_mm_s: float = 92.0,
     tol_mm: float | None = None,
+    tool_radius_mm: float = 4.0,
+    stepover_mm: float = 2.0,
+    chord_tol_mm: float = 0.001,
 ) -> str:
-    """G-code of the pocket, in mm, absolute, from the centre outwards.
+    """G-code of the pocket, in mm, absolute: a plunge in the middle of the band, then the
+    tool-centre path of :func:`pocket_rings` as one chain of G1 moves at one depth.
 
-    The defaults give about 5000 G-lines and about 220 s of motion at 92 mm/s on the
-    ``paper1_sim`` machine, like the pocketing path of Chien et al. (2023, Table 2).
+    The defaults (an 8 mm end mill, a 2 mm stepover, 1 um chordal tolerance) give about 4700
+    G-lines over 10.4 m, like the pocketing path of Chien et al. (2023, Table 2: about 5000).
 
     Parameters
     ----------
-    width_mm, height_mm : float
-        Outline of the pocket (the last tool-centre contour).
-    corner_radius_mm : float
-        Radius of the two rounded corners of the outline.
-    stepover_mm : float
-        Distance between consecutive contours.
-    segment_mm : float
-        Length of the short G-lines the rounded corners are discretised into.
     feed_mm_s : float
         Programmed feed.
     tol_mm : float, optional
         A ``G64 P`` blending tolerance for the program; none: the machine's.
+    tool_radius_mm : float
+        Radius of the end mill: the outermost rings run this far from the walls.
+    stepover_mm : float
+        Largest distance between neighbouring rings.
+    chord_tol_mm : float
+        Largest distance between an arc and its chords.
 
     Returns
     -------
     str
     """
-    for name, v in (
-        ("width_mm", width_mm),
-        ("height_mm", height_mm),
-        ("stepover_mm", stepover_mm),
-        ("segment_mm", segment_mm),
-        ("feed_mm_s", feed_mm_s),
-    ):
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"{name} = {v!r} is out of range: allowed (0, inf)")
-    if not 0 <= corner_radius_mm <= 0.5 * min(width_mm, height_mm):
-        raise ValueError(
-            f"corner_radius_mm = {corner_radius_mm!r} is out of range: allowed "
-            f"[0, {0.5 * min(width_mm, height_mm):g}]"
-        )
-    hw, hh = 0.5 * width_mm, 0.5 * height_mm
-    n_offsets = int((min(hw, hh) - stepover_mm) // stepover_mm)
-    lines = ["(nctwin pocket: contour-parallel offsets, inside out)", "G21 G90 G17"]
+    check_range("feed_mm_s", feed_mm_s, 0.0, 1000.0, low_open=True)
+    check_range("tool_radius_mm", tool_radius_mm, 0.0, 0.25 * BAND_MM, low_open=True)
+    check_range("stepover_mm", stepover_mm, 0.0, 2.0 * tool_radius_mm, low_open=True)
+    check_range("chord_tol_mm", chord_tol_mm, 0.0, 0.1 * tool_radius_mm, low_open=True)
+    if tol_mm is not None:
+        check_range("tol_mm", tol_mm, 0.0, math.inf, low_open=True)
+    path = np.round(np.vstack(pocket_rings(tool_radius_mm=tool_radius_mm,
+                                           stepover_mm=stepover_mm, chord_tol_mm=chord_tol_mm)),
+                    4)  # fmt: skip
+    keep = np.append(True, (np.diff(path, axis=0) != 0).any(axis=1))
+    path = path[keep]
+    lines = ["(nctwin pocket: contour-parallel offsets around an island, middle out)",
+             "G21 G90 G17"]  # fmt: skip
     if tol_mm is not None:
         lines.append(f"G64 P{tol_mm:g}")
     lines += [
         "G0 Z5",
-        f"G0 X0 Y{-(hh - n_offsets * stepover_mm):.4f}",
-        "G1 Z-2 F600",
+        f"G0 X{path[0, 0]:.4f} Y{path[0, 1]:.4f}",
+        "G1 Z-3 F600",
         f"F{feed_mm_s * 60:g}",
     ]
-    for i in range(n_offsets, -1, -1):
-        d = i * stepover_mm
-        c = _contour(hw - d, hh - d, max(corner_radius_mm - d, 0.0), segment_mm)
-        if i < n_offsets:
-            lines.append(f"G1 X{c[0, 0]:.4f} Y{c[0, 1]:.4f}")  # link to the next contour
-        lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in c[1:]]
+    lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in path[1:]]
     lines += ["G0 Z5", "M30"]
     return "\n".join(lines) + "\n"
