@@ -1,10 +1,11 @@
 """The ``nctwin`` command line.
 
-``nctwin estimate PROGRAM [--machine NAME] [--method cam|kernel] [--json]`` prints the cycle
-time of a part program; ``nctwin simulate PROGRAM [--machine NAME] [--plot feed.png]
+``nctwin estimate PROGRAM [--machine NAME] [--method cam|kernel|block_overlap|bilstm|axis_nn]
+[--json]`` prints the cycle time of a part program (by default with the machine profile's
+``default_method``); ``nctwin simulate PROGRAM [--machine NAME] [--plot feed.png]
 [--csv motion.csv] [--json]`` interpolates it on the FIR kernel; ``nctwin machines`` lists the
-shipped machine profiles. Bad input ends with exit
-code 2 and one line ``file:line: reason`` on standard error, never a traceback.
+shipped machine profiles. Bad input ends with exit code 2 and one line ``file:line: reason`` on
+standard error, never a traceback.
 """
 
 from __future__ import annotations
@@ -30,7 +31,11 @@ def _parser() -> argparse.ArgumentParser:
     e = sub.add_parser("estimate", help="estimate the cycle time of a part program")
     _program_args(e)
     e.add_argument(
-        "--method", default="cam", choices=sorted(METHODS), help="estimator (default: cam)"
+        "--method",
+        default=None,
+        choices=sorted(METHODS),
+        help="estimator (default: the machine profile's default_method, cam for most; "
+        "bilstm and axis_nn need a machine with recordings: linuxcnc_sim)",
     )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
@@ -103,7 +108,7 @@ def _common_rows(summary: dict, machine_note: str = "") -> list[tuple[str, str]]
 
 def _estimate(args: argparse.Namespace) -> int:
     machine, tp = _load(args)
-    result = estimate(tp, machine, args.method)
+    result = estimate(tp, machine, args.method or machine.default_method)
     summary = {"program": args.program, **result.summary()}
     rows = _common_rows(summary)
     rows.insert(2, ("method", result.method))

@@ -73,6 +73,9 @@ class MachineProfile:
     inposition_time_s : tuple of 3 floats
         Measured in-position time of X, Y, Z after a rapid, used by analytic estimators
         (Lee et al. 2022, Sec. 2.3); 0 where not measured.
+    default_method : str
+        Estimator ``nctwin estimate`` uses when none is named: the best one the chapter that
+        measured this machine found (``cam`` where none did).
     """
 
     name: str
@@ -93,6 +96,7 @@ class MachineProfile:
     position_gain_per_s: _XYZ = (30.0, 30.0, 30.0)
     inposition_width_mm: _XYZ = (0.02, 0.02, 0.02)
     inposition_time_s: _XYZ = (0.0, 0.0, 0.0)
+    default_method: str = "cam"
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:

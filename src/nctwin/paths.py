@@ -11,7 +11,14 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write_text", "cache_dir", "data_dir", "repo_root", "results_dir"]
+__all__ = [
+    "atomic_write_text",
+    "cache_dir",
+    "data_dir",
+    "public_programs_dir",
+    "repo_root",
+    "results_dir",
+]
 
 
 def repo_root() -> Path:
@@ -32,6 +39,13 @@ def results_dir() -> Path:
 def cache_dir() -> Path:
     """Generated data, keyed by a hash of its parameters (not committed)."""
     return data_dir() / "cache"
+
+
+def public_programs_dir() -> Path:
+    """Public part programs written by others (``../shared/programs`` beside the clone, or
+    ``NCTWIN_PUBLIC_PROGRAMS``). They are not shipped and may be absent."""
+    default = repo_root().parent / "shared" / "programs"
+    return Path(os.environ.get("NCTWIN_PUBLIC_PROGRAMS", default))
 
 
 def atomic_write_text(path: Path, text: str) -> Path:

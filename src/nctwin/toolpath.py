@@ -275,6 +275,19 @@ class Toolpath:
         tol[self.path_mode >= PathMode.EXACT_PATH] = 0.0
         return tol
 
+    def effective_naive_tol_mm(self) -> np.ndarray:
+        """Naive-CAM tolerance (``G64 Q``) each block is executed with, LinuxCNC's rules, (N,).
+
+        ``G64 P`` without Q sets Q = P; a plain ``G64`` or ``G61``/``G61.1`` gives 0 (off); where
+        the program set nothing, 0 (LinuxCNC starts with ``Q0`` in nctwin's profiles).
+        """
+        q = np.zeros(len(self))
+        blend = self.path_mode == PathMode.BLEND
+        given = np.isfinite(self.naive_tol_mm)
+        p = np.nan_to_num(self.blend_tol_mm, nan=0.0)
+        q[blend] = np.where(given[blend], self.naive_tol_mm[blend], p[blend])
+        return q
+
     def take(self, blocks: np.ndarray) -> Toolpath:
         """The tool path of the given blocks (indices or mask, in order); events are kept and
         re-pointed to the next kept block."""

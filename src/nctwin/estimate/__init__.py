@@ -1,7 +1,10 @@
-"""Cycle-time estimators: analytic ones, and simulation on a virtual NC kernel.
+"""Cycle-time estimators: analytic ones, simulation on a virtual NC kernel, and networks trained
+on a real control's recordings.
 
 Each method is a function ``f(toolpath, machine) -> Estimate``; :data:`METHODS` maps the names
-the CLI accepts to them. Later chapters add their methods here.
+the CLI accepts to them. ``bilstm`` and ``axis_nn`` are the networks of the chapter "Predicting a
+real controller" (:mod:`nctwin.realkernel`); they exist only for a machine with shipped
+recordings (``linuxcnc_sim``), and train once on first use.
 """
 
 from __future__ import annotations
@@ -17,11 +20,25 @@ from .result import Estimate
 
 __all__ = ["METHODS", "Estimate", "cam", "estimate", "kernel"]
 
+def _bilstm(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+    from ..realkernel import bilstm_estimate  # the networks need the recordings and torch
+
+    return bilstm_estimate(toolpath, machine)
+
+
+def _axis_nn(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+    from ..realkernel import axis_nn_estimate
+
+    return axis_nn_estimate(toolpath, machine)
+
+
 #: Estimators by name.
 METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
     "cam": cam,
     "kernel": kernel,
     "block_overlap": block_overlap,
+    "bilstm": _bilstm,
+    "axis_nn": _axis_nn,
 }
 
 

@@ -64,6 +64,7 @@ from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
 
 __all__ = [
+    "LinuxCNCAborted",
     "LinuxCNCError",
     "LinuxCNCUnavailable",
     "Recording",
@@ -100,6 +101,11 @@ class LinuxCNCError(GCodeError):
 
 class LinuxCNCUnavailable(RuntimeError):
     """LinuxCNC cannot run here (not installed, not root, user missing); says what to do."""
+
+
+class LinuxCNCAborted(RuntimeError):
+    """LinuxCNC stopped a program before its end without an error for the program itself (e.g.
+    ``USRMOT: ERROR: command timeout`` when the machine is too busy for the speed-up)."""
 
 
 def available() -> str | None:
@@ -304,6 +310,8 @@ def record(
     TimeoutError
         If the run takes longer than ``timeout_s``, or LinuxCNC does not carry out a command
         within 10 s.
+    LinuxCNCAborted
+        If LinuxCNC's motion controller reports an error (a busy machine at a high speed-up).
     """
     _check_run_args(timeout_s, speed)
     ini = ini_text(machine)
@@ -361,6 +369,12 @@ def record(
             raise TimeoutError(f"{result['stuck']}; the instance was shut down")
         if not result["ok"]:
             raise _rejected(result["message"], program)
+        aborted = [ln for ln in console.splitlines() if "USRMOT: ERROR" in ln]
+        if aborted:
+            raise LinuxCNCAborted(
+                f"LinuxCNC aborted the program ({aborted[0].strip()}): the machine was too busy "
+                f"for speed = {speed!r}; run again, or with a lower speed"
+            )
         samples = _read_samples(folder / "samples.txt")
     finally:
         shutil.rmtree(folder, ignore_errors=True)
@@ -439,6 +453,8 @@ def run(
         If LinuxCNC rejects the program.
     LinuxCNCUnavailable, TimeoutError
         See :func:`record`.
+    LinuxCNCAborted
+        If the recorded motion does not reach the program's last move.
     """
     if isinstance(toolpath_or_program, Toolpath):
         text = dump(toolpath_or_program)
@@ -456,7 +472,14 @@ def run(
         z = np.zeros((1, 3))
         return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), machine.period_s)
     rec = record(text, machine, timeout_s=timeout_s, speed=speed)
-    return motion_of(rec, tp)
+    motion = motion_of(rec, tp)
+    last = int(np.flatnonzero((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL))[-1])
+    if motion.block[-1] < last or not np.allclose(motion.pos_mm[-1], tp.end_mm[last], atol=1e-6):
+        raise LinuxCNCAborted(
+            f"LinuxCNC stopped at program line {int(rec.program_line[-1])}, before the program's "
+            f"last move (line {int(tp.line[last])}), at {motion.pos_mm[-1].round(4).tolist()} mm"
+        )
+    return motion
 
 
 def motion_of(rec: Recording, toolpath: Toolpath) -> Motion:

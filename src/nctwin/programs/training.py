@@ -39,6 +39,7 @@ __all__ = [
     "LOCAL_LENGTH_MM",
     "SHARP_SHARE",
     "ProgramSpec",
+    "broad_program",
     "contour_program",
     "global_program",
     "mixed_program",
@@ -104,13 +105,19 @@ def program_text(points_mm: np.ndarray, *, feed_mm_s: float, tol_mm: float, titl
     return "\n".join(lines) + "\n"
 
 
-def _global_section(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _global_section(
+    rng: np.random.Generator, n: int, length_mm: tuple[float, float] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Short lines on a curve: in half the sections of random lengths, in the other half of one
-    length (a CAM system's constant chord)."""
-    if rng.random() < 0.5:
-        lengths = rng.uniform(*GLOBAL_LENGTH_MM, n)
-    else:
-        lengths = np.full(n, rng.uniform(*GLOBAL_LENGTH_MM))
+    length (a CAM system's constant chord). Lengths are uniform in :data:`GLOBAL_LENGTH_MM`, or
+    log-uniform in ``length_mm`` where given."""
+
+    def draw(size=None):
+        if length_mm is None:
+            return rng.uniform(*GLOBAL_LENGTH_MM, size)
+        return _log_uniform(rng, *length_mm, size)
+
+    lengths = draw(n) if rng.random() < 0.5 else np.full(n, draw())
     return lengths, _global_turns(rng, lengths)
 
 
@@ -123,14 +130,23 @@ def _local_section(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.nda
     return _log_uniform(rng, *LOCAL_LENGTH_MM, n), turns
 
 
-def _sections(rng: np.random.Generator, n_lines: int, local_share: float):
+def _sections(
+    rng: np.random.Generator,
+    n_lines: int,
+    local_share: float,
+    global_length_mm: tuple[float, float] | None = None,
+):
     """Lengths and turns of ``n_lines`` G-lines: sections of 10-80 lines, local with
-    probability ``local_share`` (by G-line count, on average)."""
+    probability ``local_share`` (by G-line count, on average); see :func:`_global_section` for
+    ``global_length_mm``."""
     lengths, turns, count = [], [], 0
     while count < n_lines:
         n = min(int(rng.integers(*SECTION_LINES, endpoint=True)), n_lines - count)
         local = rng.random() < local_share
-        ln, tn = (_local_section if local else _global_section)(rng, n)
+        if local:
+            ln, tn = _local_section(rng, n)
+        else:
+            ln, tn = _global_section(rng, n, global_length_mm)
         lengths.append(ln)
         turns.append(tn)
         count += n
@@ -240,6 +256,68 @@ def training_specs(
         ProgramSpec(f, n_lines, float(v), round(float(e), 4), int(s))
         for f, v, e, s in zip(families, feeds, tols, seeds, strict=True)
     ]
+
+
+def broad_program(
+    seed: int | np.random.Generator,
+    *,
+    n_lines: int,
+    feed_range_mm_s: tuple[float, float],
+    tol_range_mm: tuple[float, float],
+    no_tol_share: float,
+    naive_share: float,
+    global_length_mm: tuple[float, float],
+    max_tilt_rad: float,
+    max_time_s: float,
+) -> str:
+    """A training program beyond paper 1's ranges, for a machine that runs other people's programs.
+
+    Paper 1's G-lines (sections as in :func:`mixed_program`, 25 % local) with
+
+    * the feed log-uniform in ``feed_range_mm_s`` and the ``G64 P`` tolerance log-uniform in
+      ``tol_range_mm``, or, with probability ``no_tol_share``, a plain ``G64`` (no tolerance);
+      with probability ``naive_share`` the ``G64 P`` has no ``Q`` (on LinuxCNC: Q = P, which
+      merges nearly collinear lines), else ``Q0``;
+    * the short lines of global sections log-uniform in ``global_length_mm``;
+    * the plane tilted about the X axis by a uniform angle in ``[0, max_tilt_rad]``, so that
+      lines move the Z axis too (3D surfacing);
+    * the chain cut after ``max_time_s`` of programmed (CAM) time, so that slow feeds do not
+      make hour-long programs.
+
+    Returns
+    -------
+    str
+        G-code text: ``G21 G90 G17``, ``G64 P<eps> Q0``, ``G64 P<eps>`` or ``G64``, ``G1 F``,
+        one line per point with X, Y and Z.
+    """
+    rng = _rng(seed)
+    feed = float(np.round(_log_uniform(rng, *feed_range_mm_s), 1))
+    tol = (
+        None
+        if rng.random() < no_tol_share
+        else float(np.round(_log_uniform(rng, *tol_range_mm), 4))
+    )
+    naive = rng.random() < naive_share
+    tilt = rng.uniform(0.0, max_tilt_rad)
+    lengths, turns = _sections(rng, n_lines, 0.25, global_length_mm)
+    keep = np.cumsum(lengths) / feed <= max_time_s
+    keep[0] = True
+    xy = _polyline(lengths[keep], turns[keep])
+    pts = np.column_stack([xy[:, 0], xy[:, 1] * math.cos(tilt), xy[:, 1] * math.sin(tilt)])
+    rounded = np.round(np.vstack([np.zeros(3), pts]), 4)
+    moved = np.concatenate([[True], np.any(np.diff(rounded, axis=0) != 0, axis=1)])
+    g64 = "G64" if tol is None else f"G64 P{tol:g}" + ("" if naive else " Q0")
+    tol_text = "none" if tol is None else f"{tol:g} mm"
+    lines = [
+        f"(nctwin broad training program: F {feed:g} mm/s, eps {tol_text}, "
+        f"tilt {math.degrees(tilt):.1f} deg)",
+        "G21 G90 G17",
+        g64,
+        f"G1 F{feed * 60:g}",
+    ]
+    lines += [f"X{x:.4f} Y{y:.4f} Z{z:.4f}" for x, y, z in rounded[moved][1:]]
+    lines.append("M30")
+    return "\n".join(lines) + "\n"
 
 
 # ------------------------------------------------------------------------------------------------

@@ -1,0 +1,532 @@
+r"""Predicting a real controller: every cycle-time method against LinuxCNC's recordings.
+
+The measured machine is LinuxCNC (:mod:`nctwin.kernel.linuxcnc`, profile ``linuxcnc_sim``); its
+recordings are shipped (:mod:`nctwin.recordings`). This module turns them into training data and
+runs every method on a program the way the chapter "Predicting a real controller" compares them:
+
+* ``cam``: length over feed (:func:`nctwin.estimate.cam`);
+* ``block_overlap``: Lee et al. (2022), with its time constants identified from LinuxCNC's
+  acceleration limits (:func:`identified_block_overlap_machine`);
+* ``kernel``: nctwin's FIR kernel with its time constants and acceleration limits fitted to the
+  training recordings (:func:`fit_fir`);
+* ``bilstm``: Chien et al. (2023)'s BiLSTM trained on the recordings (:func:`train_bilstm`);
+* ``axis_nn``: Sun et al. (2022)'s per-axis networks trained on the recordings
+  (:func:`train_axis_nns`).
+
+The learned methods see a program as its *moves* (:func:`model_blocks`): lines, rapids (a line at
+the rapid feed) and arcs cut into chords of at most :data:`ARC_CHORD_RAD`, the way the training
+programs' curves are written; a dwell adds its time. Their features follow LinuxCNC's rules for
+this profile: the tolerance is the program's ``G64 P`` (a plain ``G64`` means no tolerance, a
+feature value of :data:`TOL_CAP_MM`), and where no ``G61``/``G64`` is set, the profile's
+0.0254 mm; the feed is the programmed one clipped to what the axes allow along the move.
+
+Chien's features are extended by two columns: the path acceleration the axes allow along the
+move, :math:`a_k = \min_i a_{i,\max} / |u_{k,i}|` (LinuxCNC moves in 3D, and its Z axis is half
+as quick as X and Y), and the naive-CAM tolerance ``G64 Q`` (LinuxCNC merges nearly collinear
+short lines within it; a ``G64 P`` without Q sets Q = P). The targets are Chien's (eq. 1-3):
+the average feed per move and the time ratio
+:math:`s_k = F_k \tilde t_k / l_k`; the predicted cycle time is :math:`\sum_k \hat s_k l_k / F_k`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .estimate import Estimate, block_overlap, cam, kernel
+from .features import BlockTargets, sun2022_features
+from .geometry import PathGeometry
+from .machine import MachineProfile
+from .models import ModelConfig
+from .recordings import MACHINE as RECORDED_MACHINE
+from .recordings import RecordedProgram, load_recordings
+from .sun2022 import MIN_FEED_SHARE
+from .sun2022 import MODEL_CONFIG as AXIS_NN_CONFIG
+from .toolpath import MotionKind, Toolpath
+from .train import TrainConfig, Trained, fit
+
+__all__ = [
+    "ARC_CHORD_RAD",
+    "AXIS_NN_CONFIG",
+    "BILSTM_CONFIG",
+    "FEATURES",
+    "METHOD_COLUMNS",
+    "TOL_CAP_MM",
+    "MoveData",
+    "axis_nn_estimate",
+    "axis_nn_move_times",
+    "bilstm_estimate",
+    "bilstm_move_times",
+    "features",
+    "fir_machine",
+    "fit_fir",
+    "identified_block_overlap_machine",
+    "method_rows",
+    "method_summary",
+    "model_blocks",
+    "move_data",
+    "predict_axis_nn",
+    "predict_bilstm",
+    "recorded_move_data",
+    "train_axis_nns",
+    "train_bilstm",
+    "train_configs",
+    "trained_models",
+    "training_data",
+]
+
+#: Largest sweep of one chord of an arc (rad) in :func:`model_blocks`.
+ARC_CHORD_RAD = 0.1
+#: Longest chord of an arc (mm) in :func:`model_blocks`.
+ARC_CHORD_MM = 1.0
+#: Tolerance feature of a move without a tolerance (plain ``G64``; mm).
+TOL_CAP_MM = 2.0
+#: Column names of :func:`features`.
+FEATURES = (
+    "feed_mm_s", "length_mm", "theta_start_rad", "theta_end_rad", "tol_mm", "acc_mm_s2",
+    "naive_tol_mm",
+)  # fmt: skip
+#: Chien et al.'s BiLSTM (10 hidden units per direction, tanh, linear output) on seven features.
+BILSTM_CONFIG = ModelConfig("bilstm", n_inputs=len(FEATURES), n_outputs=2, hidden=10)
+
+
+def model_blocks(tp: Toolpath) -> tuple[Toolpath, np.ndarray]:
+    """The moves a learned method sees: lines, rapids and chords of arcs, of non-zero length.
+
+    Returns
+    -------
+    moves : Toolpath
+        M blocks, none of them an arc or a dwell.
+    source : ndarray of int64, shape (M,)
+        The block of ``tp`` each move comes from.
+    """
+    moving = (tp.kind != MotionKind.DWELL) & (tp.lengths_mm > 0)
+    idx = np.flatnonzero(moving)
+    sweep = np.where(tp.is_arc[idx], np.abs(tp.sweep_rad[idx]), 0.0)
+    radius = np.where(tp.is_arc[idx], tp.radius_mm[idx], 1.0)
+    pieces = np.where(
+        tp.is_arc[idx],
+        np.maximum(np.ceil(np.maximum(sweep / ARC_CHORD_RAD, sweep * radius / ARC_CHORD_MM)), 1),
+        1,
+    ).astype(np.int64)
+    source = np.repeat(idx, pieces)
+    j = np.arange(len(source)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    n = np.repeat(pieces, pieces)
+    geo = PathGeometry(tp)
+    s0 = geo.s_start_mm[source]
+    length = tp.lengths_mm[source]
+    start = geo.points(s0 + length * j / n)
+    end = geo.points(s0 + length * (j + 1) / n)
+    exact = n == 1  # keep the programmed points bit for bit where nothing is cut
+    start[exact] = tp.start_mm[source[exact]]
+    end[exact] = tp.end_mm[source[exact]]
+    moves = dataclasses.replace(
+        tp.take(source),
+        start_mm=start,
+        end_mm=end,
+        kind=np.where(tp.is_arc[source], MotionKind.LINEAR, tp.kind[source]).astype(np.int8),
+        center_mm=np.full((len(source), 3), np.nan),
+    )
+    return moves, source
+
+
+def _move_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, np.ndarray]:
+    """Feed (programmed, or rapid, clipped to the axes' and the control's limits) and path
+    acceleration the axes allow along each move, shapes (M,)."""
+    u = np.abs(moves.directions)
+    with np.errstate(divide="ignore"):
+        v_axes = np.min(np.asarray(machine.axis_max_velocity_mm_s) / u, axis=1)
+        a_axes = np.min(np.asarray(machine.axis_max_acceleration_mm_s2) / u, axis=1)
+    rapid = moves.kind == MotionKind.RAPID
+    feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
+    feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
+    return feed, a_axes
+
+
+def features(moves: Toolpath, machine: MachineProfile) -> np.ndarray:
+    r"""Features of each move, shape (M, 6), columns :data:`FEATURES`.
+
+    Chien et al. (2023, Sec. 2.2) :math:`(F, l_k, \theta_k, \theta_{k+1}, \varepsilon)` with
+    LinuxCNC's rules for the feed and tolerance (see the module docstring), and the path
+    acceleration :math:`a_k` the axes allow along the move. The tool starts and ends at rest
+    (corner angle :math:`\pi`).
+    """
+    feed, acc = _move_limits(moves, machine)
+    n = len(moves)
+    theta = np.append(moves.corner_angles_rad, np.pi)
+    if n:
+        theta[0] = np.pi
+    tol = moves.effective_tolerance_mm(machine.blend_tol_mm)
+    naive = moves.effective_naive_tol_mm()
+    return np.column_stack(
+        [feed, moves.lengths_mm, theta[:n], theta[1:], np.minimum(tol, TOL_CAP_MM), acc, naive]
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class MoveData:
+    """One recorded program as the learned methods see it.
+
+    Parameters
+    ----------
+    name : str
+    moves : Toolpath
+        :func:`model_blocks` of the program (M moves).
+    features : ndarray, shape (M, 7)
+        :func:`features`.
+    targets : ndarray, shape (M, 2)
+        Average feed (mm/s; NaN where a move's two junction points coincide) and time ratio
+        :math:`s_k = F_k \\tilde t_k / l_k`.
+    axis_features : ndarray, shape (M, 3, 9)
+        :func:`nctwin.features.sun2022_features` of the moves (feed as in ``features``).
+    axis_targets : ndarray, shape (M, 3)
+        Average axis feeds: the average feed times the move's direction.
+    dwell_s : float
+        Dwell time of the program (not part of any move).
+    measured_s : float
+        Recorded cycle time.
+    """
+
+    name: str
+    moves: Toolpath
+    features: np.ndarray
+    targets: np.ndarray
+    axis_features: np.ndarray
+    axis_targets: np.ndarray
+    dwell_s: float
+    measured_s: float
+
+
+def move_data(
+    name: str, tp: Toolpath, machine: MachineProfile, targets: BlockTargets | None = None
+) -> MoveData:
+    """Features (and, from a recording's per-block ``targets``, targets) of a program.
+
+    A recorded program must have no arcs (its blocks are the moves); without ``targets`` the
+    targets are NaN and ``measured_s`` is NaN.
+    """
+    moves, source = model_blocks(tp)
+    x = features(moves, machine)
+    feed, length = x[:, 0], x[:, 1]
+    clipped = dataclasses.replace(moves, feed_mm_s=feed)
+    ax = sun2022_features(clipped, machine.rapid_feed_mm_s)
+    dwell = float(tp.dwell_s.sum())
+    if targets is None:
+        y = np.full((len(moves), 2), np.nan)
+        measured = np.nan
+    else:
+        if len(source) != len(np.unique(source)):
+            raise ValueError(f"{name}: a recorded program with arcs cannot give move targets")
+        t = targets.time_s[source]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            avg = np.where(t > 0, targets.length_mm[source] / t, np.nan)
+        y = np.column_stack([avg, feed * t / length])
+        measured = targets.cycle_time_s
+    return MoveData(
+        name=name,
+        moves=moves,
+        features=x,
+        targets=y,
+        axis_features=ax,
+        axis_targets=np.nan_to_num(y[:, :1]) * moves.directions,
+        dwell_s=dwell,
+        measured_s=measured,
+    )
+
+
+def recorded_move_data(rec: RecordedProgram, machine: MachineProfile) -> MoveData:
+    """:func:`move_data` of a shipped recording of one of nctwin's programs."""
+    from .gcode import parse
+
+    return move_data(rec.name, parse(rec.program), machine, rec.targets)
+
+
+# ------------------------------------------------------------------------------------------------
+# Learned methods
+
+
+def train_bilstm(
+    data: Sequence[MoveData], train_config: TrainConfig, *, name: str = "linuxcnc_bilstm"
+) -> Trained:
+    """Chien et al.'s BiLSTM (:data:`BILSTM_CONFIG`) on the recordings ``data``."""
+    return fit(
+        BILSTM_CONFIG,
+        train_config,
+        [d.features for d in data],
+        [d.targets for d in data],
+        name=name,
+        progress=False,
+    )
+
+
+def bilstm_move_times(model: Trained, data: MoveData) -> np.ndarray:
+    """Predicted time of each move, :math:`\\hat s_k l_k / F_k`, shape (M,)."""
+    y = model.predict(data.features)
+    return np.maximum(y[:, 1], 0.0) * data.features[:, 1] / data.features[:, 0]
+
+
+def predict_bilstm(model: Trained, data: MoveData) -> float:
+    """Predicted cycle time: :math:`\\sum_k \\hat s_k l_k / F_k` plus the dwells."""
+    return float(bilstm_move_times(model, data).sum()) + data.dwell_s
+
+
+def train_axis_nns(
+    data: Sequence[MoveData], train_config: TrainConfig, *, name: str = "linuxcnc_axis_nn"
+) -> list[Trained]:
+    """Sun et al.'s per-axis networks (one per X, Y, Z; 9 features, 5 and 10 tanh units)."""
+    return [
+        fit(
+            AXIS_NN_CONFIG,
+            train_config,
+            [d.axis_features[:, a] for d in data],
+            [d.axis_targets[:, a : a + 1] for d in data],
+            name=f"{name}-{'xyz'[a]}",
+            progress=False,
+        )
+        for a in range(3)
+    ]
+
+
+def predict_axis_nn(models: Sequence[Trained], data: MoveData) -> float:
+    """Predicted cycle time (Sun et al. 2022, eq. 9-10) plus the dwells; the resultant feed is
+    kept above :data:`nctwin.sun2022.MIN_FEED_SHARE` of the programmed feed."""
+    return float(axis_nn_move_times(models, data).sum()) + data.dwell_s
+
+
+def axis_nn_move_times(models: Sequence[Trained], data: MoveData) -> np.ndarray:
+    """Predicted time of each move, :math:`l_k / \\lVert \\hat f_k \\rVert`, shape (M,)."""
+    axis = np.column_stack(
+        [m.predict(data.axis_features[:, a])[:, 0] for a, m in enumerate(models)]
+    )
+    feed = data.features[:, 0]
+    resultant = np.maximum(np.linalg.norm(axis, axis=1), MIN_FEED_SHARE * feed)
+    return data.features[:, 1] / resultant
+
+
+# ------------------------------------------------------------------------------------------------
+# Analytic and simulated methods
+
+
+def identified_block_overlap_machine(tp: Toolpath, machine: MachineProfile) -> MachineProfile:
+    """``machine`` with Lee et al.'s time constants identified from its acceleration limits.
+
+    A linear acc/dec filter of time constant :math:`A_T` adds :math:`A_T` to a line at feed
+    :math:`F`; LinuxCNC, accelerating at :math:`A`, adds :math:`F / A`. So
+    :math:`A_T = F / A` with :math:`F` the program's main cutting feed (the one it cuts longest
+    at) and :math:`A` the X/Y acceleration, and :math:`A_{TR} = F_r / A`, both rounded to whole
+    periods; LinuxCNC has no bell stage and no in-position wait (it blends rapids too).
+    """
+    a = min(machine.axis_max_acceleration_mm_s2[:2])
+    cut = np.isin(tp.kind, (MotionKind.LINEAR, MotionKind.ARC_CW, MotionKind.ARC_CCW))
+    feed = np.minimum(tp.feed_mm_s[cut], machine.max_feed_mm_s)
+    if feed.size:
+        values, inverse = np.unique(feed, return_inverse=True)
+        main = values[np.argmax(np.bincount(inverse, weights=tp.lengths_mm[cut]))]
+    else:
+        main = machine.rapid_feed_mm_s
+    ti = machine.period_s
+
+    def periods(t: float) -> float:
+        return max(round(t / ti), 1) * ti
+
+    return dataclasses.replace(
+        machine,
+        cut_time_constant_s=periods(main / a),
+        rapid_time_constant_s=periods(machine.rapid_feed_mm_s / a),
+        rapid_bell_s=0.0,
+        rapid_type="linear",
+        inposition_time_s=(0.0, 0.0, 0.0),
+    )
+
+
+def fir_machine(machine: MachineProfile, t1_s: float, t2_s: float, acc_scale: float):
+    """``machine`` as nctwin's FIR kernel with time constants ``t1_s``, ``t2_s`` and the axis
+    accelerations scaled by ``acc_scale`` (see :func:`fit_fir`)."""
+    return dataclasses.replace(
+        machine,
+        fir_t1_s=t1_s,
+        fir_t2_s=t2_s,
+        axis_max_acceleration_mm_s2=tuple(
+            acc_scale * a for a in machine.axis_max_acceleration_mm_s2
+        ),
+    )
+
+
+def fit_fir(
+    programs: Sequence[tuple[Toolpath, float]],
+    machine: MachineProfile,
+    grid: dict[str, Sequence[float]],
+) -> tuple[MachineProfile, list[dict]]:
+    """Fit the FIR kernel's T1, T2 and an acceleration scale to recorded cycle times.
+
+    LinuxCNC has no jerk limit and accelerates at a constant rate; the FIR kernel accelerates at
+    :math:`F / T_1` with jerk :math:`F / (T_1 T_2)`, and caps an axis's feed at
+    :math:`a_i T_1`. No single (T1, T2) is LinuxCNC, so they are fitted, together with a scale of
+    the axis accelerations the kernel enforces, by a grid search minimising the mean absolute
+    log ratio of simulated to recorded cycle time.
+
+    Parameters
+    ----------
+    programs : sequence of (Toolpath, float)
+        Training programs and their recorded cycle times.
+    machine : MachineProfile
+        The recorded machine's profile.
+    grid : dict
+        Values to try: ``t1_s``, ``t2_s``, ``acc_scale``.
+
+    Returns
+    -------
+    best : MachineProfile
+    trials : list of dict
+        Every grid point with its mean and largest absolute error (%).
+    """
+    trials = []
+    measured = np.array([m for _, m in programs])
+    for t1 in grid["t1_s"]:
+        for t2 in grid["t2_s"]:
+            for k in grid["acc_scale"]:
+                m = fir_machine(machine, t1, t2, k)
+                sim = np.array([kernel(tp, m).cycle_time_s for tp, _ in programs])
+                log_err = np.abs(np.log(sim / measured))
+                err = 100 * np.abs(sim / measured - 1)
+                trials.append(
+                    {"t1_s": t1, "t2_s": t2, "acc_scale": k, "score": float(log_err.mean()),
+                     "mean_err_pct": float(err.mean()), "max_err_pct": float(err.max())}
+                )  # fmt: skip
+    best = min(trials, key=lambda r: r["score"])
+    return fir_machine(machine, best["t1_s"], best["t2_s"], best["acc_scale"]), trials
+
+
+def analytic_times(tp: Toolpath, machine: MachineProfile, fir_fitted: MachineProfile) -> dict:
+    """Cycle times of the methods that need no training data: CAM, Lee's block overlap with
+    identified constants, and the fitted FIR kernel."""
+    lee = identified_block_overlap_machine(tp, machine)
+    return {
+        "cam": cam(tp, machine).cycle_time_s,
+        "block_overlap": block_overlap(tp, lee).cycle_time_s,
+        "kernel": kernel(tp, fir_fitted).cycle_time_s,
+    }
+
+
+# ------------------------------------------------------------------------------------------------
+# Tables
+
+#: Columns of :func:`method_rows` (the chapter's ``methods.csv``).
+METHOD_COLUMNS = ("program", "set", "method", "measured_s", "predicted_s", "err_pct")
+
+
+def method_rows(
+    programs: dict[str, tuple[str, Toolpath, MoveData]],
+    machine: MachineProfile,
+    fir_fitted: MachineProfile,
+    bilstm: Trained,
+    axis_nns: Sequence[Trained],
+) -> pd.DataFrame:
+    """Every method on every program.
+
+    Parameters
+    ----------
+    programs : dict
+        Name -> (set, parsed program, its :class:`MoveData` with ``measured_s``).
+
+    Returns
+    -------
+    DataFrame
+        One row per program x method, columns :data:`METHOD_COLUMNS`; ``err_pct`` is signed,
+        (predicted - measured) / measured x 100.
+    """
+    rows = []
+    for name, (group, tp, data) in programs.items():
+        times = analytic_times(tp, machine, fir_fitted)
+        times["bilstm"] = predict_bilstm(bilstm, data)
+        times["axis_nn"] = predict_axis_nn(axis_nns, data)
+        for method, t in times.items():
+            rows.append(
+                {"program": name, "set": group, "method": method, "measured_s": data.measured_s,
+                 "predicted_s": t, "err_pct": 100.0 * (t - data.measured_s) / data.measured_s}
+            )  # fmt: skip
+    return pd.DataFrame(rows, columns=list(METHOD_COLUMNS))
+
+
+def method_summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Median and worst absolute error (%) per set and method, and how often it underestimates."""
+    g = rows.assign(abs_err_pct=rows.err_pct.abs()).groupby(["set", "method"], sort=False)
+    return g.agg(
+        programs=("program", "size"),
+        median_abs_err_pct=("abs_err_pct", "median"),
+        worst_abs_err_pct=("abs_err_pct", "max"),
+        underestimates=("err_pct", lambda e: int((e < 0).sum())),
+    ).reset_index()
+
+
+# ------------------------------------------------------------------------------------------------
+# The chapter's trained models, for the command line
+
+
+def train_configs(seed: int = 0, scale: float = 1.0) -> tuple[TrainConfig, TrainConfig]:
+    """The chapter's training settings: the BiLSTM's and the per-axis networks'.
+
+    ``scale`` multiplies the epoch budgets (1 is the chapter's).
+    """
+    bilstm = TrainConfig(seed=seed, max_epochs=max(5, round(150 * scale)), patience=15,
+                         log_inputs=(1,))  # fmt: skip
+    axis = TrainConfig(seed=seed, loss="mse", window_lines=256, batch_size=8,
+                       max_epochs=max(5, round(200 * scale)), patience=20,
+                       learning_rate=1e-2)  # fmt: skip
+    return bilstm, axis
+
+
+def training_data(machine: MachineProfile) -> list[MoveData]:
+    """The ``train_*`` and ``broad_*`` recordings of ``machine`` as :class:`MoveData`.
+
+    Raises
+    ------
+    ValueError
+        If ``machine`` is not the machine of the shipped recordings.
+    """
+    if machine.name != RECORDED_MACHINE:
+        raise ValueError(
+            f"machine = {machine.name!r} has no recordings to learn from: allowed "
+            f"{RECORDED_MACHINE!r} (the LinuxCNC recordings)"
+        )
+    recs = load_recordings()
+    return [
+        recorded_move_data(rec, machine)
+        for name, rec in recs.items()
+        if name.startswith(("train_", "broad_"))
+    ]
+
+
+def trained_models(machine: MachineProfile, seed: int = 0) -> tuple[Trained, list[Trained]]:
+    """The chapter's BiLSTM and per-axis networks for ``machine`` (trained once, then loaded
+    from ``data/cache/models``)."""
+    data = training_data(machine)
+    bilstm_cfg, axis_cfg = train_configs(seed)
+    return train_bilstm(data, bilstm_cfg), train_axis_nns(data, axis_cfg)
+
+
+def _block_times(
+    tp: Toolpath, move_times_s: np.ndarray, method: str, machine: MachineProfile
+) -> Estimate:
+    """Per-block :class:`~nctwin.estimate.Estimate` from per-move times (dwells keep theirs)."""
+    _, source = model_blocks(tp)
+    t = np.bincount(source, weights=move_times_s, minlength=len(tp)) + tp.dwell_s
+    return Estimate(method, machine.name, t, tp)
+
+
+def bilstm_estimate(tp: Toolpath, machine: MachineProfile) -> Estimate:
+    """``nctwin estimate --method bilstm``: the chapter's BiLSTM (LinuxCNC recordings only)."""
+    model, _ = trained_models(machine)
+    data = move_data("program", tp, machine)
+    return _block_times(tp, bilstm_move_times(model, data), "bilstm", machine)
+
+
+def axis_nn_estimate(tp: Toolpath, machine: MachineProfile) -> Estimate:
+    """``nctwin estimate --method axis_nn``: the chapter's per-axis networks (LinuxCNC only)."""
+    _, models = trained_models(machine)
+    data = move_data("program", tp, machine)
+    return _block_times(tp, axis_nn_move_times(models, data), "axis_nn", machine)

@@ -1,0 +1,103 @@
+"""The chapter "Predicting a real controller" (nctwin.realkernel): moves, features and LinuxCNC's
+rules, checked on programs small enough to work out by hand."""
+
+import math
+
+import numpy as np
+import pytest
+
+from nctwin import realkernel as rk
+from nctwin.estimate import estimate
+from nctwin.features import BlockTargets
+from nctwin.gcode import parse
+from nctwin.machine import load_machine
+
+MACHINE = load_machine("linuxcnc_sim")  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
+
+
+def col(name: str) -> int:
+    return rk.FEATURES.index(name)
+
+
+def test_arc_becomes_chords_on_the_arc():
+    # a quarter circle of radius 10 mm: 1.571 rad, 15.7 mm -> 16 chords of at most 1 mm
+    tp = parse("G21 G90 G17\nG1 X10 F600\nG3 X0 Y10 I-10 J0\nG1 X-5\n", start_mm=(0, 0, 0))
+    moves, source = rk.model_blocks(tp)
+    pieces = math.ceil(max(math.pi / 2 / rk.ARC_CHORD_RAD, 10 * math.pi / 2 / rk.ARC_CHORD_MM))
+    assert len(moves) == 2 + pieces
+    assert (moves.kind == 1).all()  # all linear
+    np.testing.assert_array_equal(source, [0] + [1] * pieces + [2])
+    ends = moves.end_mm[1 : 1 + pieces]
+    np.testing.assert_allclose(np.hypot(ends[:, 0], ends[:, 1]), 10.0, atol=1e-9)
+    np.testing.assert_allclose(moves.end_mm[pieces], [0, 10, 0], atol=1e-9)
+    # chords are continuous and the lines keep their programmed points exactly
+    np.testing.assert_allclose(moves.start_mm[1:], moves.end_mm[:-1], atol=1e-9)
+    np.testing.assert_array_equal(moves.end_mm[0], [10, 0, 0])
+
+
+def test_dwells_and_zero_moves_are_not_moves():
+    tp = parse("G21 G90\nG1 X10 F600\nG4 P0.5\nG1 X10\nG1 X20\n", start_mm=(0, 0, 0))
+    data = rk.move_data("p", tp, MACHINE)
+    assert len(data.moves) == 2
+    assert data.dwell_s == 0.5
+
+
+def test_feed_is_clipped_to_axes_and_control():
+    # X at F 30000 mm/min (500 mm/s) -> 200; Z alone at 150 mm/s -> Z's 100; rapid -> 200
+    tp = parse("G21 G90\nG1 X10 F30000\nG1 Z10 F9000\nG0 X0\n", start_mm=(0, 0, 0))
+    x = rk.features(rk.model_blocks(tp)[0], MACHINE)
+    np.testing.assert_allclose(x[:, col("feed_mm_s")], [200.0, 100.0, 200.0])
+
+
+def test_path_acceleration_along_the_move():
+    tp = parse("G21 G90\nG1 X10 F600\nG1 X20 Y10\nG1 Z10\n", start_mm=(0, 0, 0))
+    acc = rk.features(rk.model_blocks(tp)[0], MACHINE)[:, col("acc_mm_s2")]
+    np.testing.assert_allclose(acc, [1000.0, 1000.0 * math.sqrt(2), 500.0])
+
+
+@pytest.mark.parametrize(
+    ("g64", "tol", "naive"),
+    [
+        ("", 0.0254, 0.0),  # LinuxCNC's start-up G64 P0.0254 Q0
+        ("G64 P0.1", 0.1, 0.1),  # P without Q: Q = P
+        ("G64 P0.1 Q0", 0.1, 0.0),
+        ("G64 P0.1 Q0.01", 0.1, 0.01),
+        ("G64", rk.TOL_CAP_MM, 0.0),  # no tolerance
+        ("G61", 0.0, 0.0),
+    ],
+)
+def test_linuxcnc_tolerance_rules(g64, tol, naive):
+    tp = parse(f"G21 G90\n{g64}\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
+    x = rk.features(rk.model_blocks(tp)[0], MACHINE)
+    np.testing.assert_allclose(x[:, col("tol_mm")], tol)
+    np.testing.assert_allclose(x[:, col("naive_tol_mm")], naive)
+
+
+def test_targets_from_block_targets():
+    # two lines of 10 mm at 10 mm/s: measured 1.5 s and 1.25 s over 9.9 and 10 mm
+    tp = parse("G21 G90\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
+    bt = BlockTargets(np.array([0, 1500, 2750]), np.array([9.9, 10.0]), np.array([1.5, 1.25]))
+    d = rk.move_data("p", tp, MACHINE, bt)
+    np.testing.assert_allclose(d.targets[:, 0], [9.9 / 1.5, 10 / 1.25])
+    np.testing.assert_allclose(d.targets[:, 1], [1.5, 1.25])  # F t / l
+    np.testing.assert_allclose(d.axis_targets, [[9.9 / 1.5, 0, 0], [0, 8.0, 0]])
+    assert d.measured_s == 2.75
+
+
+def test_block_overlap_constants_from_acceleration():
+    # main cutting feed 100 mm/s (the longer cut) -> A_T = 100 / 1000 = 0.1 s; A_TR = 0.2 s
+    tp = parse("G21 G90\nG1 X100 F6000\nG1 Y10 F1200\n", start_mm=(0, 0, 0))
+    m = rk.identified_block_overlap_machine(tp, MACHINE)
+    assert m.cut_time_constant_s == pytest.approx(0.1)
+    assert m.rapid_time_constant_s == pytest.approx(0.2)
+    assert m.inposition_time_s == (0.0, 0.0, 0.0)
+    # a single line: L/F + A_T, LinuxCNC's L/F + F/A
+    line = parse("G21 G90\nG1 X100 F6000\n", start_mm=(0, 0, 0))
+    lee = rk.identified_block_overlap_machine(line, MACHINE)
+    assert estimate(line, lee, "block_overlap").cycle_time_s == pytest.approx(1.0 + 0.1)
+
+
+def test_learned_methods_need_recordings():
+    tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
+    with pytest.raises(ValueError, match="has no recordings"):
+        estimate(tp, load_machine("paper1_sim"), "bilstm")
