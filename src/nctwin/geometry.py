@@ -40,6 +40,7 @@ class PathGeometry:
         self._ax = ax
         self._theta0 = np.arctan2(rel[rows, ax[:, 1]], rel[rows, ax[:, 0]])
         d = tp.end_mm - tp.start_mm
+        self._chord = d
         self._dn = d[rows, ax[:, 2]]
         self._sweep = tp.sweep_rad
         rel_end = tp.end_mm - tp.center_mm
@@ -58,10 +59,13 @@ class PathGeometry:
             return np.zeros((len(s_mm), 3))
         s = np.clip(s_mm, 0.0, self.total_mm)
         k = self.block_at(s)
-        length = self.lengths_mm[k]
-        frac = np.divide(s - self.s_start_mm[k], length, out=np.zeros_like(s), where=length > 0)
+        length = self.lengths_mm.take(k)
+        frac = np.divide(
+            s - self.s_start_mm.take(k), length, out=np.zeros_like(s), where=length > 0
+        )
         frac = np.clip(frac, 0.0, 1.0)
-        out = tp.start_mm[k] + frac[:, None] * (tp.end_mm[k] - tp.start_mm[k])
+        out = np.take(tp.start_mm, k, axis=0)  # take: faster than fancy indexing
+        out += frac[:, None] * np.take(self._chord, k, axis=0)
         arc = self._arc[k]
         if arc.any():
             ka, fa = k[arc], frac[arc]

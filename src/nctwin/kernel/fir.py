@@ -113,23 +113,34 @@ class FirFilter:
     def apply(self, x: np.ndarray) -> np.ndarray:
         """Filter sampled positions ``x``, shape (3, n), axis-major, that start and end at rest.
 
-        Returns shape (3, n + n1 + n2 - 2): the input is held at its first and last value
-        outside its span. Each box is a difference of running sums, O(n); the sums run over
-        positions relative to the start, which keeps their rounding below 1e-7 mm.
+        Returns shape (3, n + n1 + n2 - 2), the transpose of a C-contiguous (n + n1 + n2 - 2, 3)
+        array: the input is held at its first and last value outside its span. Each box is a
+        difference of running sums, O(n); the sums run over positions relative to the start,
+        which keeps their rounding below 1e-7 mm. Two buffers are reused across the boxes.
         """
-        x0 = x[:, :1]
-        out = x - x0
-        for n in self.taps:
-            if n > 1:
-                m = out.shape[1]
-                held = np.empty((3, m + 2 * n - 1))
-                held[:, :n] = 0.0
-                held[:, n : n + m] = out
-                held[:, n + m :] = out[:, -1:]
-                c = np.cumsum(held, axis=1)
-                out = c[:, n:] - c[:, :-n]
-                out /= n
-        return out + x0
+        x0 = x[:, 0]
+        taps = [n for n in self.taps if n > 1]
+        m = x.shape[1]
+        size = m + sum(taps) - len(taps)
+        cur, other = np.empty((size, 3)), np.empty((size, 3))
+        np.subtract(x.T, x0, out=cur[:m])
+        for n in taps:
+            # running sum of the input held at its last value for n - 1 more samples ...
+            c = other
+            np.cumsum(cur[:m], axis=0, out=c[:m])
+            tail = np.empty((n, 3))
+            tail[0] = c[m - 1]
+            tail[1:] = cur[m - 1]
+            np.cumsum(tail, axis=0, out=tail)
+            c[m : m + n - 1] = tail[1:]
+            # ... minus the sum n samples earlier (zero before the start), over n
+            k = m + n - 1
+            cur[:n] = c[:n]
+            np.subtract(c[n:k], c[: k - n], out=cur[n:k])
+            cur[:k] /= n
+            m = k
+        cur += x0
+        return cur.T
 
 
 def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
@@ -246,11 +257,18 @@ def _deviation_nodes(fir: FirFilter) -> tuple[np.ndarray, np.ndarray]:
     return wg, og
 
 
-def plan(tp: Toolpath, machine: MachineProfile, fir: FirFilter | None = None) -> Plan:
-    """Look-ahead: cruise feeds, junction speeds and pauses (see the module docstring)."""
+def plan(
+    tp: Toolpath,
+    machine: MachineProfile,
+    fir: FirFilter | None = None,
+    geo: PathGeometry | None = None,
+) -> Plan:
+    """Look-ahead: cruise feeds, junction speeds and pauses (see the module docstring).
+
+    ``fir`` and ``geo`` default to the machine's filter and the path's geometry."""
     fir = fir or FirFilter.of(machine)
     n = len(tp)
-    geo = PathGeometry(tp)
+    geo = geo if geo is not None else PathGeometry(tp)
     feed = _block_feeds(tp, machine, fir)
     v = np.zeros(n + 1)
     pause = np.zeros(n + 1)
@@ -440,49 +458,78 @@ MAX_SLOWDOWNS = 12
 SLOWDOWN_MARGIN = 0.02
 
 
+def _first_change(x: np.ndarray, ref: np.ndarray) -> int:
+    """Index of the first row of ``x`` (n, 3) that differs from ``ref`` (3,), ``n`` if none.
+
+    Searches growing chunks from the start: the answer is near it, and the rest is not read."""
+    start, size = 0, 256
+    while start < len(x):
+        hit = np.flatnonzero((x[start : start + size] != ref).any(axis=1))
+        if len(hit):
+            return start + int(hit[0])
+        start, size = start + size, 4 * size
+    return len(x)
+
+
 def _interpolate(tp, geo, fir: FirFilter, t_knots, s_knots):
     """Sample the command at the period and filter it; exact rest at both ends.
 
-    Returns the filtered positions, shape (3, n) axis-major, and the filter lag in samples."""
+    Returns the filtered positions, shape (n, 3), and the filter lag in samples."""
     ts = fir.period_s
     t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
     x_knots = geo.points(s_knots)
     n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
     t_cmd = np.arange(n_cmd) * ts
-    x = np.empty((3, n_cmd))
+    x = np.empty((n_cmd, 3))
     for a in range(3):
-        x[a] = np.interp(t_cmd, t_knots, x_knots[:, a])
-    x[:, 0], x[:, -1] = tp.start_mm[0], tp.end_mm[-1]
-    pos = fir.apply(x)
+        x[:, a] = np.interp(t_cmd, t_knots, x_knots[:, a])
+    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
+    pos = fir.apply(x.T).T
     n1, n2 = fir.taps
     lag = n1 + n2 - 2
     # the filter's sums of equal values carry rounding: rest is exact at both ends
-    moving = np.flatnonzero(np.any(x != x[:, :1], axis=0))
-    pos[:, : moving[0] if len(moving) else n_cmd] = x[:, :1]
-    still = np.flatnonzero(np.any(x != x[:, -1:], axis=0))
-    pos[:, (still[-1] + 1 + lag) if len(still) else 0 :] = x[:, -1:]
+    pos[: _first_change(x, x[0])] = x[0]
+    still = _first_change(x[::-1], x[-1])  # samples at rest at the end
+    pos[n_cmd - still + lag if still < n_cmd else 0 :] = x[-1]
     return pos, lag
 
 
-def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray | None:
+def _velocity(pos: np.ndarray, ts: float) -> np.ndarray:
+    """Axis velocities (n, 3) of positions ``pos`` (n, 3): backward differences, 0 first."""
+    vel = np.empty_like(pos)
+    vel[:1] = 0.0
+    np.subtract(pos[1:], pos[:-1], out=vel[1:])
+    vel[1:] /= ts
+    return vel
+
+
+def _limit_ratio(vel: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray | None:
     """Largest ratio of axis velocity, acceleration and jerk to their limits, per sample.
 
-    ``pos`` is (3, n); derivatives are backward differences. Returns shape (n,), or None when
-    no sample exceeds a limit (the common case, checked first on the maxima)."""
-    derivs = []
-    d = pos
-    for _ in range(3):
-        d = np.diff(d, axis=1) / ts
+    ``vel`` is (n, 3), from :func:`_velocity`; derivatives are backward differences. Returns
+    shape (n,), or None when no sample exceeds a limit (the common case, checked first on the
+    maxima)."""
+    derivs = [vel[1:]]
+    for _ in range(2):
+        d = np.diff(derivs[-1], axis=0)
+        d /= ts
         derivs.append(d)
-    peaks = np.array([np.abs(d).max(axis=1, initial=0.0) for d in derivs])  # (order, axis)
-    if (peaks <= limits * (1.0 + LIMIT_RTOL)).all():
-        return None
-    ratio = np.zeros(pos.shape[1])
+    over = []  # (order, axis) of the derivatives above their limit
     for order, d in enumerate(derivs):
+        bound = limits[order] * (1.0 + LIMIT_RTOL)
+        # whole-array extremes are fast; per axis only where some axis may exceed its limit
+        if np.maximum(d.max(initial=0.0), -d.min(initial=0.0)) <= bound.min():
+            continue
         for a in range(3):
-            if peaks[order, a] > limits[order, a] * (1.0 + LIMIT_RTOL):
-                r = np.abs(d[a]) / limits[order, a]
-                np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
+            col = d[:, a]
+            if np.maximum(col.max(initial=0.0), -col.min(initial=0.0)) > bound[a]:
+                over.append((order, a))
+    if not over:
+        return None
+    ratio = np.zeros(len(vel))
+    for order, a in over:
+        r = np.abs(derivs[order][:, a]) / limits[order, a]
+        np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
     return ratio
 
 
@@ -505,12 +552,12 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     ts = fir.period_s
     # zero-length moves are no-ops: plan without them, report the kept blocks' indices
     kept = np.flatnonzero((toolpath.lengths_mm > 0) | (toolpath.kind == MotionKind.DWELL))
-    tp = toolpath.take(kept)
+    tp = toolpath if len(kept) == len(toolpath) else toolpath.take(kept)
     if len(tp) == 0:
         z = np.zeros((1, 3))
         return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), ts)
     geo = PathGeometry(tp)
-    cmd = _command(tp, geo, plan(tp, machine, fir), fir)
+    cmd = _command(tp, geo, plan(tp, machine, fir, geo), fir)
     limits = np.array(
         [
             machine.axis_max_velocity_mm_s,
@@ -522,7 +569,8 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     for _ in range(MAX_SLOWDOWNS + 1):
         t_knots, s_knots = cmd.knots(scale)
         pos, lag = _interpolate(tp, geo, fir, t_knots, s_knots)
-        ratio = _limit_ratio(pos, ts, limits)
+        vel = _velocity(pos, ts)
+        ratio = _limit_ratio(vel, ts, limits)
         if ratio is None:
             break
         # slow the command over the windows that made the violating samples
@@ -535,12 +583,10 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         factor = _range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
         slow = factor < 1.0
         scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
-    vel = np.zeros_like(pos)
-    vel[:, 1:] = np.diff(pos, axis=1) / ts
-    t = np.arange(pos.shape[1]) * ts
+    t = np.arange(len(pos)) * ts
     # block of each sample: the command's block at the centre of the filter window
     first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
     counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
     counts[0] += min(first_sample[0], len(t))
     block = np.repeat(cmd.segment_blocks(), counts)
-    return Motion(t, pos.T, vel.T, kept[block], ts)
+    return Motion(t, pos, vel, kept[block], ts)
