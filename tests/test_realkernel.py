@@ -79,7 +79,7 @@ def test_targets_from_block_targets():
     bt = BlockTargets(np.array([0, 1500, 2750]), np.array([9.9, 10.0]), np.array([1.5, 1.25]))
     d = rk.move_data("p", tp, MACHINE, bt)
     np.testing.assert_allclose(d.targets[:, 0], [9.9 / 1.5, 10 / 1.25])
-    np.testing.assert_allclose(d.targets[:, 1], [1.5, 1.25])  # F t / l
+    np.testing.assert_allclose(d.targets[:, 1], np.log([1.5, 1.25]))  # ln(F t / l)
     np.testing.assert_allclose(d.axis_targets, [[9.9 / 1.5, 0, 0], [0, 8.0, 0]])
     assert d.measured_s == 2.75
 

@@ -2,8 +2,11 @@
 
 The live test records two short programs of the shipped set on LinuxCNC and compares them with
 the shipped recordings bit for bit (SHA-256 of the full position trace, per-block targets); it
-is skipped where LinuxCNC cannot run (``make linuxcnc``).
+is skipped where LinuxCNC cannot run (``make linuxcnc``). Public programs (not shipped) are
+checked where ``../shared/programs`` lies beside the clone.
 """
+
+import json
 
 import numpy as np
 import pytest
@@ -16,22 +19,62 @@ from nctwin.toolpath import MotionKind
 SHIPPED = recordings.load_recordings()
 MACHINE = load_machine(recordings.MACHINE)
 PERIOD_S = MACHINE.period_s
-#: The two shortest programs of the set (global training programs of 200 short lines, ~2 s).
-LIVE = sorted(SHIPPED, key=lambda name: SHIPPED[name].n_samples)[:2]
+OWN = sorted(n for n, r in SHIPPED.items() if r.source == "nctwin")
+PUBLIC = sorted(n for n, r in SHIPPED.items() if r.source != "nctwin")
+#: The two shortest of nctwin's own programs (a few seconds each).
+LIVE = sorted(OWN, key=lambda name: SHIPPED[name].n_samples)[:2]
 
 
 def test_shipped_set_is_the_specified_set():
     programs = recordings.recording_programs()
-    assert sorted(SHIPPED) == sorted(programs)
+    assert OWN == sorted(programs)
     for name, text in programs.items():
         assert SHIPPED[name].program == text
+        assert SHIPPED[name].program_sha256 == recordings.text_sha256(text)
         assert SHIPPED[name].machine == recordings.MACHINE
+    assert len([n for n in OWN if n.startswith("train_")]) >= 60
+
+
+def test_public_recordings_ship_no_program_text():
+    assert PUBLIC, "the public programs' recordings are shipped"
+    rejected = json.loads((recordings.recording_dir() / recordings.PUBLIC_REJECTED).read_text())
+    for name in PUBLIC:
+        rec = SHIPPED[name]
+        assert rec.program == "" and rec.source.startswith("public/")
+        assert rec.source.removeprefix("public/") not in rejected
+
+
+def test_public_program_absent_or_changed(tmp_path):
+    rec = SHIPPED[PUBLIC[0]]
+    assert recordings.public_program_text(rec, tmp_path) is None
+    (tmp_path / rec.source.removeprefix("public/")).write_text("G1 X1\n")
+    with pytest.raises(ValueError, match="SHA-256 differs"):
+        recordings.public_program_text(rec, tmp_path)
+
+
+def test_public_program_nctwin_rejects_needs_no_linuxcnc(tmp_path):
+    (tmp_path / "bad.ngc").write_text("G1 X#1\n")
+    recorded, rejected = recordings.record_public(tmp_path, tmp_path / "out")
+    assert recorded == [] and list(rejected) == ["bad.ngc"]
+    assert "bad.ngc:1:" in rejected["bad.ngc"]
+    saved = json.loads((tmp_path / "out" / recordings.PUBLIC_REJECTED).read_text())
+    assert saved == rejected
+
+
+def _text(name: str) -> str:
+    rec = SHIPPED[name]
+    if rec.source == "nctwin":
+        return rec.program
+    text = recordings.public_program_text(rec)
+    if text is None:
+        pytest.skip(f"{rec.source} is not beside this clone")
+    return text
 
 
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_recording_is_consistent(name):
     rec = SHIPPED[name]
-    tp = parse(rec.program)
+    tp = parse(_text(name))
     t = rec.targets
     assert len(t.time_s) == len(tp) == len(t.length_mm) == len(t.junction_sample) - 1
     # the junctions cover the whole trace: the block times add up to the recorded duration
@@ -42,10 +85,17 @@ def test_shipped_recording_is_consistent(name):
     cut = tp.kind != MotionKind.RAPID
     limit = MACHINE.rapid_feed_mm_s if not cut.all() else np.max(tp.feed_mm_s)
     assert rec.feed_mm_s.max() <= limit * (1 + 1e-4)  # never above F (or the rapid feed)
-    # blending cuts corners: the blended path is no longer than the programmed one
+    # blending cuts corners: the blended path is no longer than the programmed one, and the
+    # recording reaches the program's last move (LinuxCNC did not stop early)
     assert t.length_mm.sum() <= tp.lengths_mm.sum() + 1e-6
-    # CAM time of the cutting moves (length / F) is a lower bound of the real cycle time
-    assert rec.cycle_time_s >= (tp.lengths_mm[cut] / tp.feed_mm_s[cut]).sum() - 1e-9
+    last = np.flatnonzero(tp.lengths_mm > 0)[-1]
+    assert t.time_s[last] > 0
+    # the blended length at the commanded feed (clipped to the machine's) is a lower bound of
+    # the cycle time (CAM's own bound uses the programmed length, which blending shortens)
+    feed = np.where(cut, tp.feed_mm_s, MACHINE.rapid_feed_mm_s)
+    feed = np.minimum(feed, MACHINE.max_feed_mm_s)
+    moving = tp.lengths_mm > 0
+    assert rec.cycle_time_s >= (t.length_mm[moving] / feed[moving]).sum() - 1e-6
 
 
 @pytest.mark.usefixtures("linuxcnc_live")

@@ -121,10 +121,11 @@ def _estimate(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
+    from .estimate.kernel import fir_setup
     from .kernel import fir
 
     machine, tp = _load(args)
-    motion = fir.run(tp, machine)
+    motion = fir.run(*fir_setup(tp, machine))
     summary = {
         "program": args.program,
         "machine": machine.name,

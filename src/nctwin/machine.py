@@ -55,6 +55,15 @@ class MachineProfile:
         Corner-blending tolerance used where the program sets none (G64 P overrides it).
     fir_t1_s, fir_t2_s : float
         Time constants of the FIR interpolator: acceleration ``F / T1``, jerk ``F / (T1 T2)``.
+    fir_acc_scale : float
+        The FIR kernel enforces the axis accelerations times this (1 for the kernel's own
+        machines; fitted where the kernel stands in for another control).
+    fir_blend_ratio : float
+        The FIR kernel blends a junction within at most this share of the shorter of its two
+        moves (a plain ``G64`` within this alone); ``inf``: the program's tolerance only.
+    fir_block_periods : int
+        Shortest time of a move on the FIR kernel, in periods (a control's block-processing
+        rate): a move of length ``l`` runs at most at ``l / (n period_s)``; 0: no limit.
     cut_time_constant_s : float
         Acc/dec time constant of cutting feed (linear type, after interpolation).
     rapid_time_constant_s : float
@@ -89,6 +98,9 @@ class MachineProfile:
     blend_tol_mm: float = 0.05
     fir_t1_s: float = 0.05
     fir_t2_s: float = 0.01
+    fir_acc_scale: float = 1.0
+    fir_blend_ratio: float = math.inf
+    fir_block_periods: int = 0
     cut_time_constant_s: float = 0.05
     rapid_time_constant_s: float = 0.1
     rapid_bell_s: float = 0.0
@@ -129,6 +141,13 @@ class MachineProfile:
         for f in ("fir_t1_s", "fir_t2_s", "cut_time_constant_s", "rapid_time_constant_s"):
             _check(f, getattr(self, f), 0.0, 10.0, lo_closed=True, hi_closed=True)
         _check("rapid_bell_s", self.rapid_bell_s, 0.0, 10.0, lo_closed=True, hi_closed=True)
+        _check("fir_acc_scale", self.fir_acc_scale, 0.0, 100.0)
+        _check("fir_blend_ratio", self.fir_blend_ratio, 0.0, 1.0, hi_closed=True, allow_inf=True)
+        if not isinstance(self.fir_block_periods, int) or not 0 <= self.fir_block_periods <= 100:
+            raise ValueError(
+                f"fir_block_periods = {self.fir_block_periods!r} is out of range: "
+                "allowed integers in [0, 100]"
+            )
         if self.rapid_type not in ("linear", "nonlinear"):
             raise ValueError(
                 f"rapid_type = {self.rapid_type!r} is not allowed: allowed 'linear', 'nonlinear'"
