@@ -1,4 +1,4 @@
-"""BiLSTM inference time on the ~5450-G-line pocket (Chien et al. 2023, Table 2): one forward
+"""BiLSTM inference time on the ~4700-G-line pocket (Chien et al. 2023, Table 2): one forward
 pass over the whole program, untrained weights of the chapter's architecture (the time does not
 depend on the weights)."""
 

@@ -26,7 +26,12 @@ percent of the short G-lines), :math:`\bar f_k` is undefined and left out of the
 
 "Machine B" (Table 3) is recorded the way a real control's trace is: :class:`Recording` adds a
 first-order position loop (servo lag, with the wait for the in-position window at the end) and
-encoder noise to the kernel's command positions before the targets are read.
+encoder noise to the kernel's command positions before the targets are read. The block label of
+each recorded sample is delayed by the loop's following time :math:`1/K_v` with the position, so
+that it names the block the axes are on, as the kernel's labels do for its own output; without
+that delay the junction search (which only looks at samples labelled with the two blocks that
+meet) misses the junctions of G-lines shorter than :math:`F/K_v` and moves time between
+neighbouring short G-lines (:func:`recording_effects` measures it).
 
 Simulations of a list of programs run through :mod:`joblib` (one task per program) and are
 cached in ``data/cache/chien2023/`` under a hash of the programs' text, the machine and the
@@ -72,13 +77,14 @@ __all__ = [
     "paper_beside",
     "plot_feed_per_line",
     "predict_run",
+    "recording_effects",
     "simulate",
     "simulate_one",
     "write_programs",
 ]
 
 #: Cache format version (part of every cache key).
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 #: Floor of a predicted average feed (mm/s), so that a prediction near 0 stays a finite time.
 MIN_FEED_MM_S = 1.0
 
@@ -91,7 +97,8 @@ class Recording:
     ----------
     position_gain_1_s : float
         Gain ``Kv`` of a first-order position loop per axis (1/s); the actual position lags the
-        command by ``F / Kv``. 0: no lag (the simulation profile).
+        command by ``F / Kv``, in time by ``1 / Kv``, and so do the recorded block labels. 0: no
+        lag (the simulation profile).
     in_position_mm : float
         The motion ends when every axis is this close to the end point.
     noise_mm : float
@@ -106,7 +113,8 @@ class Recording:
     seed: int = 0
 
     def apply(self, motion: Motion, rng: np.random.Generator) -> Motion:
-        """The recorded motion: lagged, extended until in position, noisy."""
+        """The recorded motion: lagged, extended until in position, noisy; the block labels
+        delayed by the following time."""
         ts = motion.period_s
         pos = motion.pos_mm
         block = motion.block
@@ -121,7 +129,9 @@ class Recording:
             pos = np.column_stack(
                 [lfilter([0.0, a], [1.0, a - 1.0], cmd[:, i], zi=cmd[:1, i])[0] for i in range(3)]
             )
-            block = np.concatenate([block, np.full(extra, block[-1])])
+            delay = round(1.0 / a)  # the loop's following time in samples (1 / Kv as ts -> 0)
+            block = np.concatenate([np.full(delay, block[0]), block, np.full(extra, block[-1])])
+            block = block[: len(pos)]
         if self.noise_mm > 0:
             pos = pos + rng.normal(0.0, self.noise_mm, pos.shape)
         vel = np.zeros_like(pos)
@@ -181,6 +191,74 @@ def simulate_one(
         bt.cycle_time_s,
         cam(tp, machine).cycle_time_s,
     )
+
+
+def recording_effects(
+    text: str, machine: MachineProfile, recordings: dict[str, Recording], *, short_mm: float = 1.0
+) -> pd.DataFrame:
+    """How a recording changes the per-G-line targets of one program (the Table 3 diagnosis).
+
+    The targets are read from the kernel's own motion (the reference) and from each recorded
+    motion, once with the recorded labels (delayed with the position) and once with the
+    interpolator's labels (not delayed, as before the fix), and compared G-line by G-line.
+
+    Parameters
+    ----------
+    text : str
+        A G-code program.
+    machine : MachineProfile
+    recordings : dict
+        ``name -> Recording``; each draws its noise with ``[recording.seed, 0]``.
+    short_mm : float
+        G-lines shorter than this count as short.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per recording and label timing: ``recording``, ``labels`` (``"delayed"`` or
+        ``"interpolator"``), ``measured_s``, and over the short and the long G-lines the mean
+        time ratio :math:`s_k` (``s_mean_short``, ``s_mean_long``; the reference's in the
+        ``reference`` row) and the RMS of its change from the reference (``s_rms_short``,
+        ``s_rms_long``), the mean change of the average feed (``feed_bias_mm_s``) and the share
+        of G-lines whose two junction points are the same sample (``zero_time_pct``).
+    """
+    tp = cutting_blocks(gcode.parse(text))
+    motion = fir.run(tp, machine)
+    lengths = tp.lengths_mm
+    short = lengths < short_mm
+
+    def read(m: Motion) -> tuple[np.ndarray, np.ndarray, float, float]:
+        bt = block_targets(m, tp)
+        ratio = tp.feed_mm_s * bt.time_s / lengths
+        return ratio, bt.avg_feed_mm_s, bt.cycle_time_s, 100.0 * float(np.mean(bt.time_s == 0))
+
+    def mean(x: np.ndarray) -> float:
+        return float(x.mean()) if len(x) else np.nan
+
+    s0, f0, t0, z0 = read(motion)
+    rows = [{"recording": "reference", "labels": "kernel", "measured_s": t0,
+             "s_mean_short": mean(s0[short]), "s_mean_long": mean(s0[~short]),
+             "s_rms_short": 0.0, "s_rms_long": 0.0, "feed_bias_mm_s": 0.0,
+             "zero_time_pct": z0}]  # fmt: skip
+    for name, rec in recordings.items():
+        recorded = rec.apply(motion, np.random.default_rng([rec.seed, 0]))
+        undelayed = np.concatenate(
+            [motion.block, np.full(len(recorded) - len(motion), motion.block[-1])]
+        )
+        variants = {"delayed": recorded}
+        if rec.position_gain_1_s > 0:
+            variants["interpolator"] = Motion(
+                recorded.t_s, recorded.pos_mm, recorded.vel_mm_s, undelayed, recorded.period_s
+            )
+        for labels, m in variants.items():
+            s, f, t, z = read(m)
+            d2 = (s - s0) ** 2
+            rows.append({"recording": name, "labels": labels, "measured_s": t,
+                         "s_mean_short": mean(s[short]), "s_mean_long": mean(s[~short]),
+                         "s_rms_short": np.sqrt(mean(d2[short])),
+                         "s_rms_long": np.sqrt(mean(d2[~short])),
+                         "feed_bias_mm_s": np.nanmean(f - f0), "zero_time_pct": z})  # fmt: skip
+    return pd.DataFrame(rows)
 
 
 def _cache_key(texts: Sequence[str], machine: MachineProfile, recording: Recording | None) -> str:
