@@ -63,6 +63,37 @@ def test_filter_taps_span_the_time_constants():
     assert FILTER.length_s == pytest.approx(MACHINE.fir_t1_s + MACHINE.fir_t2_s)
 
 
+@pytest.mark.parametrize("t2_s", [0.0, 0.01])
+def test_filter_is_the_convolution_with_its_weights(t2_s):
+    # running sums in reused buffers against a direct convolution of the held input
+    flt = fir.FirFilter(0.05, t2_s, 0.001)
+    rng = np.random.default_rng(0)
+    x = np.cumsum(rng.normal(size=(3, 700)), axis=1) + np.array([[5.0], [-3.0], [100.0]])
+    w = flt.weights
+    held = np.concatenate(
+        [np.repeat(x[:, :1], len(w) - 1, 1), x, np.repeat(x[:, -1:], len(w), 1)], 1
+    )
+    expected = np.array([np.convolve(row, w, mode="valid") for row in held])[
+        :, : x.shape[1] + len(w) - 1
+    ]
+    out = flt.apply(x)
+    assert out.shape == expected.shape
+    np.testing.assert_allclose(out, expected, rtol=0, atol=1e-9)
+
+
+def test_range_min_matches_brute_force():
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        n = int(rng.integers(1, 80))
+        lo = rng.integers(0, n, 12)
+        hi = np.minimum(lo + rng.integers(0, n + 1, 12), n)
+        value = rng.uniform(0, 1, 12)
+        expected = np.full(n, np.inf)
+        for a, b, v in zip(lo, hi, value, strict=True):
+            expected[a:b] = np.minimum(expected[a:b], v)
+        np.testing.assert_array_equal(fir._range_min(n, lo, hi, value), expected)
+
+
 def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0

@@ -39,6 +39,7 @@ Conventions: the filters act on the command positions sampled at the interpolati
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -246,8 +247,10 @@ V_RTOL = 0.002
 DEVIATION_NODES = 24
 
 
+@lru_cache(maxsize=16)
 def _deviation_nodes(fir: FirFilter) -> tuple[np.ndarray, np.ndarray]:
-    """Pooled weights and time offsets (s) of the filter taps, centred on the middle tap."""
+    """Pooled weights and time offsets (s) of the filter taps, centred on the middle tap
+    (cached per filter: the plan evaluates them in every step; not to be modified)."""
     w = fir.weights
     offsets = (0.5 * (len(w) - 1) - np.arange(len(w))) * fir.period_s
     nodes = min(DEVIATION_NODES, len(w))
@@ -340,12 +343,12 @@ def _range_min(n: int, lo: np.ndarray, hi: np.ndarray, value: np.ndarray) -> np.
     out = np.full(n, np.inf)
     if n == 0 or len(lo) == 0:
         return out
-    levels = max(1, int(np.ceil(np.log2(n))) + 1)
-    tables = [np.full(n, np.inf) for _ in range(levels)]
     length = hi - lo
     keep = length > 0
     lo, hi, value, length = lo[keep], hi[keep], value[keep], length[keep]
     k = np.floor(np.log2(np.maximum(length, 1))).astype(np.int64)
+    levels = int(k.max()) + 1 if len(k) else 1  # no table above the longest range's level
+    tables = [np.full(n, np.inf) for _ in range(levels)]
     # each range is the union of two blocks of size 2**k: [lo, lo+2**k) and [hi-2**k, hi)
     for level in np.unique(k):
         m = k == level
@@ -374,14 +377,19 @@ class _Command:
     pause: np.ndarray
     pause_block: np.ndarray
 
-    def knots(self, scale: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Time and arc-length knots (2C,) of the command, speeds multiplied by ``scale``."""
+    def knot_times(self, scale: np.ndarray | None = None) -> np.ndarray:
+        """Time knots (2C,) of the command, speeds multiplied by ``scale``: arrival at and
+        departure from each cut, whose arc length is :attr:`knot_s`."""
         speed = self.speed if scale is None else self.speed * scale
         dur = np.diff(self.cuts) / speed
         arrive = np.concatenate([[0.0], np.cumsum(dur)])
         arrive[1:] += np.cumsum(self.pause)[:-1]
-        t = np.column_stack([arrive, arrive + self.pause]).ravel()
-        return t, np.repeat(self.cuts, 2)
+        return np.column_stack([arrive, arrive + self.pause]).ravel()
+
+    @property
+    def knot_s(self) -> np.ndarray:
+        """Arc-length knots (2C,) of the command: each cut twice."""
+        return np.repeat(self.cuts, 2)
 
     def segment_blocks(self) -> np.ndarray:
         """Block of each of the 2C - 1 time segments between knots (pause, move, pause, ...)."""
@@ -423,12 +431,16 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Comma
 ARC_CHORD_TOL_MM = 1e-6
 
 
-def _refine_arcs(tp: Toolpath, geo: PathGeometry, t_knots, s_knots):
-    """Add knots inside arcs so that interpolating positions linearly in time between knots
-    stays within :data:`ARC_CHORD_TOL_MM` of the arc (speed is constant between knots)."""
+def _arc_refinement(tp: Toolpath, geo: PathGeometry, s_knots: np.ndarray):
+    """Knots to add inside arcs so that interpolating positions linearly in time between knots
+    stays within :data:`ARC_CHORD_TOL_MM` of the arc (speed is constant between knots).
+
+    Returns, for the refined knots, the interval of ``s_knots`` each starts and its fraction of
+    the way along it (both shape (R,)), for :func:`_refined`; None where no knot is added. The
+    refinement depends on arc lengths only: it holds for the time knots of every pass."""
     ds = np.diff(s_knots)
     if not tp.is_arc.any() or not len(ds):
-        return t_knots, s_knots
+        return None
     mid = 0.5 * (s_knots[:-1] + s_knots[1:])
     b = geo.block_at(mid)
     r = np.where(tp.is_arc[b], tp.radius_mm[b], np.inf)
@@ -442,12 +454,18 @@ def _refine_arcs(tp: Toolpath, geo: PathGeometry, t_knots, s_knots):
     need = np.divide(planar, dphi, out=np.zeros_like(planar), where=dphi > 0)
     parts = np.maximum(1, np.ceil(need).astype(np.int64))
     if parts.max() == 1:
-        return t_knots, s_knots
+        return None
     seg = np.repeat(np.arange(len(ds)), parts)
     frac = (np.arange(len(seg)) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[seg]
-    t_new = np.append(t_knots[seg] + frac * np.diff(t_knots)[seg], t_knots[-1])
-    s_new = np.append(s_knots[seg] + frac * ds[seg], s_knots[-1])
-    return t_new, s_new
+    return seg, frac
+
+
+def _refined(knots: np.ndarray, refinement) -> np.ndarray:
+    """Time or arc-length knots (K,) with the knots of :func:`_arc_refinement` added."""
+    if refinement is None:
+        return knots
+    seg, frac = refinement
+    return np.append(knots[seg] + frac * np.diff(knots)[seg], knots[-1])
 
 
 #: Relative excess over an axis limit that counts as a violation (rounding of differences).
@@ -471,13 +489,12 @@ def _first_change(x: np.ndarray, ref: np.ndarray) -> int:
     return len(x)
 
 
-def _interpolate(tp, geo, fir: FirFilter, t_knots, s_knots):
-    """Sample the command at the period and filter it; exact rest at both ends.
+def _interpolate(tp, fir: FirFilter, t_knots, x_knots):
+    """Sample the command, positions ``x_knots`` (K, 3) at times ``t_knots`` (K,), at the period
+    and filter it; exact rest at both ends.
 
     Returns the filtered positions, shape (n, 3), and the filter lag in samples."""
     ts = fir.period_s
-    t_knots, s_knots = _refine_arcs(tp, geo, t_knots, s_knots)
-    x_knots = geo.points(s_knots)
     n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
     t_cmd = np.arange(n_cmd) * ts
     x = np.empty((n_cmd, 3))
@@ -533,6 +550,16 @@ def _limit_ratio(vel: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray |
     return ratio
 
 
+def _moves(tp: Toolpath) -> np.ndarray:
+    """Blocks of nonzero length, shape (N,): ``tp.lengths_mm > 0``, with the arc geometry
+    (which the kernel computes again on the kept blocks) evaluated on the arcs only."""
+    moves = np.linalg.norm(tp.end_mm - tp.start_mm, axis=1) > 0  # the chord of lines
+    arc = np.flatnonzero(tp.is_arc)
+    if len(arc):
+        moves[arc] = tp.take(arc).lengths_mm > 0
+    return moves
+
+
 def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     """Interpolate a tool path on the FIR kernel.
 
@@ -551,7 +578,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     fir = FirFilter.of(machine)
     ts = fir.period_s
     # zero-length moves are no-ops: plan without them, report the kept blocks' indices
-    kept = np.flatnonzero((toolpath.lengths_mm > 0) | (toolpath.kind == MotionKind.DWELL))
+    kept = np.flatnonzero(_moves(toolpath) | (toolpath.kind == MotionKind.DWELL))
     tp = toolpath if len(kept) == len(toolpath) else toolpath.take(kept)
     if len(tp) == 0:
         z = np.zeros((1, 3))
@@ -565,10 +592,16 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
             machine.axis_max_jerk_mm_s3,
         ]
     )
+    # the path points of the knots are the same in every pass: computed once
+    refinement = _arc_refinement(tp, geo, cmd.knot_s)
+    if refinement is None:
+        x_knots = np.repeat(geo.points(cmd.cuts), 2, axis=0)
+    else:
+        x_knots = geo.points(_refined(cmd.knot_s, refinement))
     scale = np.ones(len(cmd.speed))
     for _ in range(MAX_SLOWDOWNS + 1):
-        t_knots, s_knots = cmd.knots(scale)
-        pos, lag = _interpolate(tp, geo, fir, t_knots, s_knots)
+        t_knots = cmd.knot_times(scale)
+        pos, lag = _interpolate(tp, fir, _refined(t_knots, refinement), x_knots)
         vel = _velocity(pos, ts)
         ratio = _limit_ratio(vel, ts, limits)
         if ratio is None:
