@@ -145,12 +145,16 @@ record: venv linuxcnc
 # goes to build/papermill/ first and replaces book/notebooks/<name> only on success.
 # `make notebooks` re-executes all; `make book`/`make test` execute only those whose executed copy
 # is missing (order-only prerequisites: a fresh clone's file times never trigger a re-run).
+# Figures: the kernel draws inline only with this backend (the exported Agg would drop them);
+# progress bars stay out of the executed notebooks.
+NB_MPLBACKEND := module://matplotlib_inline.backend_inline
 NB_FORCE :=
 book/notebooks/%.ipynb: $(NB_FORCE) | notebooks/%.ipynb venv
 	@mkdir -p book/notebooks build/papermill
 	@src=notebooks/$*.ipynb; tmp=build/papermill/$*.ipynb; t0=$$(date +%s); \
 	echo "notebooks: executing $$src"; \
-	if ! $(VENV)/bin/papermill --cwd "$(CURDIR)" -k python3 --no-progress-bar \
+	if ! MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 \
+	     $(VENV)/bin/papermill --cwd "$(CURDIR)" -k python3 --no-progress-bar \
 	     "$$src" "$$tmp"; then \
 	  echo "notebooks: $$src FAILED; the partly executed notebook is $$tmp" >&2; exit 1; \
 	fi; \

@@ -28,13 +28,25 @@ def test_estimate_prints_time_length_blocks_and_kinds(program, capsys):
 
 
 def test_estimate_json(program, capsys):
-    assert main(["estimate", str(program), "--json", "--machine", "linuxcnc_sim"]) == 0
+    args = ["estimate", str(program), "--json", "--machine", "linuxcnc_sim", "--method", "cam"]
+    assert main(args) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["method"] == "cam" and data["machine"] == "linuxcnc_sim"
     assert data["blocks"] == 3
     assert data["length_mm"] == pytest.approx(40.0)
     # 5 mm rapid at 200 mm/s + 35 mm at 10 mm/s
     assert data["cycle_time_s"] == pytest.approx(5 / 200 + 3.5)
+
+
+def test_estimate_default_method_is_the_profiles(program, capsys):
+    # linuxcnc_sim defaults to the LinuxCNC chapter's BiLSTM (trained once from the shipped
+    # recordings). LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2,
+    # 2 sqrt(5 / 500) = 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners
+    # (0.0254 mm tolerance), each plus F / a: 0.5 + 0.02 + 3.0 + 0.01 = 3.53 s; 3.73 s in all.
+    assert main(["estimate", str(program), "--json", "--machine", "linuxcnc_sim"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["method"] == "bilstm"
+    assert data["cycle_time_s"] == pytest.approx(3.73, rel=0.05)
 
 
 def test_bad_program_gives_file_line_reason_and_exit_2(tmp_path, capsys):

@@ -4,6 +4,7 @@ rules, checked on programs small enough to work out by hand."""
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from nctwin import realkernel as rk
@@ -11,6 +12,7 @@ from nctwin.estimate import estimate
 from nctwin.features import BlockTargets
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
+from nctwin.paths import results_dir
 
 MACHINE = load_machine("linuxcnc_sim")  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
 
@@ -101,3 +103,13 @@ def test_learned_methods_need_recordings():
     tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
     with pytest.raises(ValueError, match="has no recordings"):
         estimate(tp, load_machine("paper1_sim"), "bilstm")
+
+
+def test_profile_carries_the_chapters_fit_and_best_method():
+    # linuxcnc_sim's FIR stand-in settings and default method are the chapter's results
+    results = results_dir() / "linuxcnc_real_kernel"
+    best = pd.read_csv(results / "fir_fit.csv").iloc[0]  # sorted by score
+    for field in rk.FIR_FIELDS:
+        assert getattr(MACHINE, field) == pytest.approx(best[field])
+    summary = pd.read_csv(results / "summary.csv")
+    assert MACHINE.default_method == rk.best_method(summary)

@@ -61,10 +61,12 @@ __all__ = [
     "FEATURES",
     "FIR_FIELDS",
     "METHOD_COLUMNS",
+    "TIME_TARGETS",
     "TOL_CAP_MM",
     "MoveData",
     "axis_nn_estimate",
     "axis_nn_move_times",
+    "best_method",
     "bilstm_estimate",
     "bilstm_move_times",
     "features",
@@ -256,29 +258,48 @@ def recorded_move_data(rec: RecordedProgram, machine: MachineProfile) -> MoveDat
 # Learned methods
 
 
+#: Second output of the BiLSTM: the log time ratio (the chapter's), or the ratio itself (the
+#: Chien chapter's, kept as an ablation).
+TIME_TARGETS = ("log_ratio", "ratio")
+
+
+def _check_time_target(time_target: str) -> None:
+    if time_target not in TIME_TARGETS:
+        raise ValueError(f"time_target = {time_target!r} is unknown: allowed {TIME_TARGETS}")
+
+
 def train_bilstm(
-    data: Sequence[MoveData], train_config: TrainConfig, *, name: str = "linuxcnc_bilstm"
+    data: Sequence[MoveData],
+    train_config: TrainConfig,
+    *,
+    name: str = "linuxcnc_bilstm",
+    time_target: str = "log_ratio",
 ) -> Trained:
-    """Chien et al.'s BiLSTM (:data:`BILSTM_CONFIG`) on the recordings ``data``."""
-    return fit(
-        BILSTM_CONFIG,
-        train_config,
-        [d.features for d in data],
-        [d.targets for d in data],
-        name=name,
-        progress=False,
-    )
+    """Chien et al.'s BiLSTM (:data:`BILSTM_CONFIG`) on the recordings ``data``.
+
+    ``time_target`` ``"ratio"`` learns :math:`s_k` itself instead of :math:`\\ln s_k`.
+    """
+    _check_time_target(time_target)
+    ys = [d.targets for d in data]
+    if time_target == "ratio":
+        ys = [np.column_stack([y[:, 0], np.exp(y[:, 1])]) for y in ys]
+        name = f"{name}_ratio"
+    return fit(BILSTM_CONFIG, train_config, [d.features for d in data], ys, name=name,
+               progress=False)  # fmt: skip
 
 
-def bilstm_move_times(model: Trained, data: MoveData) -> np.ndarray:
-    """Predicted time of each move, :math:`e^{\\widehat{\\ln s_k}} l_k / F_k`, shape (M,)."""
-    y = model.predict(data.features)
-    return np.exp(y[:, 1]) * data.features[:, 1] / data.features[:, 0]
+def bilstm_move_times(model: Trained, data: MoveData, time_target: str = "log_ratio") -> np.ndarray:
+    """Predicted time of each move, :math:`e^{\\widehat{\\ln s_k}} l_k / F_k` (or
+    :math:`\\max(\\hat s_k, 0) l_k / F_k` for ``time_target="ratio"``), shape (M,)."""
+    _check_time_target(time_target)
+    y = model.predict(data.features)[:, 1]
+    ratio = np.exp(y) if time_target == "log_ratio" else np.maximum(y, 0.0)
+    return ratio * data.features[:, 1] / data.features[:, 0]
 
 
-def predict_bilstm(model: Trained, data: MoveData) -> float:
+def predict_bilstm(model: Trained, data: MoveData, time_target: str = "log_ratio") -> float:
     """Predicted cycle time: the sum of :func:`bilstm_move_times` plus the dwells."""
-    return float(bilstm_move_times(model, data).sum()) + data.dwell_s
+    return float(bilstm_move_times(model, data, time_target).sum()) + data.dwell_s
 
 
 def train_axis_nns(
@@ -540,3 +561,13 @@ def axis_nn_estimate(tp: Toolpath, machine: MachineProfile) -> Estimate:
     _, models = trained_models(machine)
     data = move_data("program", tp, machine)
     return _block_times(tp, axis_nn_move_times(models, data), "axis_nn", machine)
+
+
+def best_method(summary: pd.DataFrame) -> str:
+    """The method with the lowest median error on the public programs (on the test paths where
+    no public program was run): the default of ``nctwin estimate`` for the recorded machine."""
+    group = "public" if (summary.set == "public").any() else "test paths"
+    rows = summary[summary.set == group].sort_values(
+        ["median_abs_err_pct", "worst_abs_err_pct"], kind="stable"
+    )
+    return str(rows.method.iloc[0])

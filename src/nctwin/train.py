@@ -391,9 +391,7 @@ def _train(
     if init is not None:
         model.load_state_dict(init.model.state_dict())
     if cfg.optimiser == "sgd":
-        optimiser = torch.optim.SGD(
-            model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
-        )
+        optimiser = torch.optim.SGD(model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum)
     else:
         optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
     val_windows = _windows([len(zx[i]) for i in val_idx], w, None)
