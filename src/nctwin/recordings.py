@@ -41,6 +41,7 @@ from tqdm import tqdm
 from .estimate.cam import cam as estimate_cam
 from .features import BlockTargets, block_targets
 from .gcode import GCodeError, parse
+from .kernel.linuxcnc import LinuxCNCAborted
 from .machine import MachineProfile, load_machine
 from .motion import Motion
 from .paths import atomic_write_text, data_dir, public_programs_dir
@@ -363,7 +364,7 @@ def _record_public_one(
             source=f"public/{path.name}",
             timeout_s=timeout_s,
         )
-    except (GCodeError, TimeoutError) as exc:  # LinuxCNCError is a GCodeError too
+    except (GCodeError, TimeoutError, LinuxCNCAborted) as exc:  # LinuxCNCError: a GCodeError
         return path.name, str(exc)
 
 
