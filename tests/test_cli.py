@@ -39,14 +39,25 @@ def test_estimate_json(program, capsys):
 
 
 def test_estimate_default_method_is_the_profiles(program, capsys):
-    # linuxcnc_sim defaults to the LinuxCNC chapter's BiLSTM (trained once from the shipped
-    # recordings). LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2,
-    # 2 sqrt(5 / 500) = 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners
-    # (0.0254 mm tolerance), each plus F / a: 0.5 + 0.02 + 3.0 + 0.01 = 3.53 s; 3.73 s in all.
+    # linuxcnc_sim defaults to its chapter's best method, the FIR kernel fitted to LinuxCNC.
+    # LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2, 2 sqrt(5 / 500) =
+    # 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners (0.0254 mm
+    # tolerance), each plus F / a: 0.5 + 0.02 + 3.0 + 0.01 = 3.53 s; 3.73 s in all (LinuxCNC
+    # recorded 3.71 s).
     assert main(["estimate", str(program), "--json", "--machine", "linuxcnc_sim"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["method"] == "bilstm"
+    assert data["method"] == "kernel"
     assert data["cycle_time_s"] == pytest.approx(3.73, rel=0.05)
+
+
+@pytest.mark.parametrize("method", ["bilstm", "axis_nn"])
+def test_estimate_with_the_linuxcnc_networks(program, capsys, method):
+    # trained once from the shipped recordings (then loaded from data/cache/models)
+    args = ["estimate", str(program), "--json", "--machine", "linuxcnc_sim", "--method", method]
+    assert main(args) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["method"] == method
+    assert data["cycle_time_s"] == pytest.approx(3.73, rel=0.25)
 
 
 def test_bad_program_gives_file_line_reason_and_exit_2(tmp_path, capsys):
