@@ -20,6 +20,7 @@ from .result import Estimate
 
 __all__ = ["METHODS", "Estimate", "cam", "estimate", "kernel"]
 
+
 def _bilstm(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     from ..realkernel import bilstm_estimate  # the networks need the recordings and torch
 
