@@ -56,9 +56,7 @@ def test_property_sphere_step_error_is_the_sagitta_of_the_cl_chord(
     radius_mm, tool_radius_mm, sweep_rad, n_points, inside
 ) -> None:
     surface = Sphere(radius_mm, inside=inside, sweep_rad=sweep_rad)
-    path = iso_parametric_path(
-        surface, n_lines=3, n_points=n_points, tool_radius_mm=tool_radius_mm
-    )
+    path = iso_parametric_path(surface, n_lines=3, n_points=n_points, tool_radius_mm=tool_radius_mm)
     result = step_error_um(path)
     expected = _reference(surface, n_points, tool_radius_mm)
     np.testing.assert_allclose(result.error_um, expected, rtol=0, atol=TOL_UM)

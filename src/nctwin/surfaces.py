@@ -263,9 +263,7 @@ class Cylinder:
         phi = self.phi0_rad + np.asarray(u, float) * self.sweep_rad
         y = self.length_mm * np.asarray(v, float)
         radial = np.stack([np.sin(phi), np.zeros_like(phi), np.cos(phi)], axis=-1)
-        point = self.radius_mm * radial + np.stack(
-            [np.zeros_like(y), y, np.zeros_like(y)], axis=-1
-        )
+        point = self.radius_mm * radial + np.stack([np.zeros_like(y), y, np.zeros_like(y)], axis=-1)
         return point, (-radial if self.inside else radial)
 
     def point(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
