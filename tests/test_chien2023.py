@@ -7,7 +7,7 @@ from nctwin import chien2023 as ch
 from nctwin import gcode
 from nctwin.kernel import fir
 from nctwin.machine import load_machine
-from nctwin.programs.training import global_program
+from nctwin.programs.training import global_program, mixed_program
 
 MACHINE_B = load_machine("paper1_machine_b")
 
@@ -49,3 +49,23 @@ def test_noise_alone_leaves_the_times_almost_unchanged():
     # a sample either way at a junction: large on the shortest G-lines, nothing on average
     assert noise.s_mean_short == pytest.approx(ref.s_mean_short, rel=0.02)
     assert noise.s_rms_short < 0.2 * ref.s_mean_short
+
+
+def test_time_by_length_splits_the_cycle_time():
+    import torch
+
+    from nctwin.models import ModelConfig, build
+    from nctwin.train import Scaler, TrainConfig, Trained
+
+    machine = load_machine("paper1_sim")
+    run = ch.simulate_one(mixed_program(7, n_lines=200, feed_mm_s=80.0, tol_mm=0.3), machine)
+    model = build(ModelConfig("bilstm", n_outputs=2), generator=torch.Generator().manual_seed(0))
+    trained = Trained(model, Scaler.fit([run.features], log_columns=[1]),
+                      Scaler(np.zeros(2), np.ones(2)), TrainConfig(), {}, 0, 0.0,
+                      ch.paths.cache_dir())  # fmt: skip
+    row = ch.time_by_length({("p", 80.0, 0.3): run}, trained).iloc[0]
+    assert row.short_lines + row.long_lines == len(run.features)
+    assert row.long_lines >= 1
+    assert row.short_measured_s + row.long_measured_s == pytest.approx(run.measured_s)
+    predicted = ch.predict_run(trained, run)[2]
+    assert row.short_predicted_s + row.long_predicted_s == pytest.approx(predicted)

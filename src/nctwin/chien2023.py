@@ -80,6 +80,7 @@ __all__ = [
     "recording_effects",
     "simulate",
     "simulate_one",
+    "time_by_length",
     "write_programs",
 ]
 
@@ -397,6 +398,34 @@ def cycle_time_rows(
             row[f"{m}_err_pct"] = error_pct(t, run.measured_s)
         row["cam_s"] = run.cam_s
         row["cam_err_pct"] = error_pct(run.cam_s, run.measured_s)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def time_by_length(
+    runs: dict[tuple[str, float, float], ProgramRun], trained: Trained, *, short_mm: float = 1.0
+) -> pd.DataFrame:
+    """Measured and predicted time spent on the short and on the long G-lines of each program:
+    where a cycle-time error comes from.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per key of ``runs``: ``toolpath, feed_mm_s, tol_mm``, then for ``short``
+        (:math:`l_k` < ``short_mm``) and ``long`` G-lines ``<class>_lines``,
+        ``<class>_measured_s``, ``<class>_predicted_s`` and ``<class>_err_pct`` (signed, of the
+        class's measured time).
+    """
+    rows = []
+    for (name, feed, tol), run in runs.items():
+        t_hat = predict_run(trained, run)[1]
+        short = run.features[:, 1] < short_mm
+        row = {"toolpath": name, "feed_mm_s": feed, "tol_mm": tol}
+        for label, sel in (("short", short), ("long", ~short)):
+            measured, predicted = run.block_time_s[sel].sum(), t_hat[sel].sum()
+            row |= {f"{label}_lines": int(sel.sum()), f"{label}_measured_s": measured,
+                    f"{label}_predicted_s": predicted,
+                    f"{label}_err_pct": 100.0 * (predicted - measured) / measured}  # fmt: skip
         rows.append(row)
     return pd.DataFrame(rows)
 
