@@ -2,9 +2,10 @@
 of Chien et al. (2023, Fig. 8-9, after Endo & Sencer 2022).
 
 The part: a pocket whose outline (:data:`OUTLINE_MM`) is a polygon with sharp corners, small
-corner fillets, a chamfer and one large-radius corner, and an island (a boss) that follows the
-outline at a distance :data:`BAND_MM`, so the floor to clear is a band of constant width between
-two walls. The tool (radius ``tool_radius_mm``) clears the band with contour-parallel offsets:
+corner fillets, a chamfer, a bulge of one wall and one large-radius corner, and an island that
+follows the outline at a distance :data:`BAND_MM`, so the floor to clear is a band of constant
+width between two walls. The tool (radius ``tool_radius_mm``) clears the band with
+contour-parallel offsets:
 
 * **Offsets.** At every level :math:`d` (the tool centre's distance from the nearest wall) there
   are two rings: the outline offset inward by :math:`d` (straight walls stay single long G-lines;
@@ -37,8 +38,8 @@ __all__ = ["BAND_MM", "OUTLINE_MM", "pocket_program", "pocket_rings"]
 
 #: Outline of the pocket's wall, counter-clockwise: vertices (mm) and the fillet radius of each
 #: corner (0: sharp). A 5 mm fillet bottom-left, a sharp corner bottom-right, a chamfer of two
-#: sharp 135-degree corners top-right, a shallow boss reaching into the pocket from the top wall
-#: (6 mm fillets at its foot, 15 mm at its two reflex corners), a large 70 mm round top-left and
+#: sharp 135-degree corners top-right, a shallow bulge of the top wall into the pocket (6 mm
+#: fillets at its foot, 15 mm at its two reflex corners), a large 70 mm round top-left and
 #: a 12 mm fillet where the slanted wall meets the left side. Edge 0 (the bottom wall) is
 #: horizontal: every ring starts on it.
 OUTLINE_MM = (
