@@ -39,14 +39,14 @@ def test_estimate_json(program, capsys):
 
 
 def test_estimate_default_method_is_the_profiles(program, capsys):
-    # linuxcnc_sim defaults to its chapter's best method, the FIR kernel fitted to LinuxCNC.
+    # linuxcnc_sim defaults to its chapter's best method, the blend-arc planner.
     # LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2, 2 sqrt(5 / 500) =
     # 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners (0.0254 mm
     # tolerance), each plus F / a: 0.5 + 0.02 + 3.0 + 0.01 = 3.53 s; 3.73 s in all (LinuxCNC
     # recorded 3.71 s).
     assert main(["estimate", str(program), "--json", "--machine", "linuxcnc_sim"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["method"] == "kernel"
+    assert data["method"] == "planner"
     assert data["cycle_time_s"] == pytest.approx(3.73, rel=0.05)
 
 

@@ -11,7 +11,9 @@ runs every method on a program the way the chapter "Predicting a real controller
   training recordings (:func:`fit_fir`);
 * ``bilstm``: Chien et al. (2023)'s BiLSTM trained on the recordings (:func:`train_bilstm`);
 * ``axis_nn``: Sun et al. (2022)'s per-axis networks trained on the recordings
-  (:func:`train_axis_nns`).
+  (:func:`train_axis_nns`);
+* ``planner``: no paper's method, the blend-arc look-ahead planner of
+  :mod:`nctwin.estimate.blend_planner`, LinuxCNC's rules written down as physics.
 
 The learned methods see a program as its *moves* (:func:`model_blocks`): lines, rapids (a line at
 the rapid feed) and arcs cut into chords of at most :data:`ARC_CHORD_RAD`, the way the training
@@ -43,6 +45,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from .estimate import Estimate, block_overlap, cam, kernel
+from .estimate.blend_planner import blend_planner
 from .features import BlockTargets, sun2022_features
 from .geometry import PathGeometry
 from .machine import MachineProfile
@@ -434,12 +437,14 @@ def fit_fir(
 
 def analytic_times(tp: Toolpath, machine: MachineProfile, fir_fitted: MachineProfile) -> dict:
     """Cycle times of the methods that need no training data: CAM, Lee's block overlap with
-    identified constants, and the fitted FIR kernel."""
+    identified constants, the fitted FIR kernel, and the blend-arc planner
+    (:mod:`nctwin.estimate.blend_planner`)."""
     lee = identified_block_overlap_machine(tp, machine)
     return {
         "cam": cam(tp, machine).cycle_time_s,
         "block_overlap": block_overlap(tp, lee).cycle_time_s,
         "kernel": kernel(tp, fir_fitted).cycle_time_s,
+        "planner": blend_planner(tp, machine).cycle_time_s,
     }
 
 

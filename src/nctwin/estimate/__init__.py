@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 from ..machine import MachineProfile
 from ..toolpath import Toolpath
+from .blend_planner import blend_planner
 from .block_overlap import block_overlap
 from .cam import cam
 from .kernel import kernel
@@ -38,6 +39,7 @@ METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
     "cam": cam,
     "kernel": kernel,
     "block_overlap": block_overlap,
+    "planner": blend_planner,
     "bilstm": _bilstm,
     "axis_nn": _axis_nn,
 }
