@@ -189,6 +189,9 @@ lint: venv
 unit: venv
 	$(PY) -m pytest
 
+# nbval re-executes the notebooks in the environment papermill executed them in (inline figures,
+# no progress bars on stderr): a checked cell whose training outlasts the bar's delay would
+# otherwise print to stderr, which its executed copy does not have.
 # Chapters whose checked tables include the public programs of ../shared/programs (not shipped):
 # nbval skips them where those programs are not beside the clone.
 NEEDS_PUBLIC    := book/notebooks/linuxcnc_real_kernel.ipynb
@@ -202,7 +205,7 @@ nbval: venv | $(EXECUTED)
 	fi; \
 	if [ $${#nbs[@]} -eq 0 ]; then echo "nbval: book/notebooks/ holds no executed notebook; skipped"; exit 0; fi; \
 	echo "nbval: $${nbs[*]}"; \
-	$(PY) -m pytest --nbval-lax --nbval-current-env -p no:cacheprovider "$${nbs[@]}"
+	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env -p no:cacheprovider "$${nbs[@]}"
 
 browser: book chromium
 	@t0=$$(date +%s); \
