@@ -1,11 +1,11 @@
 """The ``nctwin`` command line.
 
-``nctwin estimate PROGRAM [--machine NAME] [--method cam|kernel|block_overlap|bilstm|axis_nn]
-[--json]`` prints the cycle time of a part program (by default with the machine profile's
-``default_method``); ``nctwin simulate PROGRAM [--machine NAME] [--plot feed.png]
-[--csv motion.csv] [--json]`` interpolates it on the FIR kernel; ``nctwin machines`` lists the
-shipped machine profiles. Bad input ends with exit code 2 and one line ``file:line: reason`` on
-standard error, never a traceback.
+``nctwin estimate PROGRAM [--machine NAME]
+[--method cam|kernel|block_overlap|planner|bilstm|axis_nn] [--json]`` prints the cycle time of
+a part program (by default with the machine profile's ``default_method``); ``nctwin simulate
+PROGRAM [--machine NAME] [--plot feed.png] [--csv motion.csv] [--json]`` interpolates it on the
+FIR kernel; ``nctwin machines`` lists the shipped machine profiles. Bad input ends with exit
+code 2 and one line ``file:line: reason`` on standard error, never a traceback.
 """
 
 from __future__ import annotations
