@@ -35,6 +35,18 @@ export JUPYTER_PREFER_ENV_PATH := 1
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
+# Same numbers on every x86-64 CPU with AVX2: numpy, OpenBLAS, torch (ATen, MKL, oneDNN) pick
+# their kernels by CPU, and AVX-512 kernels round differently from AVX2 ones (trained networks
+# then differ in every digit). Pinning all of them to the AVX2 paths changes nothing on an AVX2
+# machine and makes an AVX-512 machine compute what it does.
+ifeq ($(shell uname -m),x86_64)
+export NPY_DISABLE_CPU_FEATURES := X86_V4 AVX512_ICL AVX512_SPR
+export OPENBLAS_CORETYPE := Haswell
+export ATEN_CPU_CAPABILITY := avx2
+export MKL_CBWR := AVX2
+export ONEDNN_MAX_CPU_ISA := AVX2
+endif
+
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
         clean distclean linuxcnc record FORCE
 

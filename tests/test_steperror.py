@@ -133,3 +133,15 @@ def test_bad_parameters_raise() -> None:
         step_error_iterative_um(path, xatol=0.0)
     with pytest.raises(ValueError, match="radius_mm"):
         chord_step_error_um(4.0, 5.0, 0.1, inside=True)
+
+
+def test_extremes_at_segment_ends_equal_the_iterative_method() -> None:
+    # near inflections d(u) is monotone on a segment: the extreme is an end, found from the
+    # end normals without any Newton step
+    path = iso_parametric_path(paper_surface(3))
+    result = step_error_um(path)
+    seg = path.segments()
+    at_end = np.flatnonzero((result.u_critical == seg["u0"]) | (result.u_critical == seg["u1"]))
+    assert 20 < len(at_end) < 0.1 * path.n_segments
+    iterative = step_error_iterative_um(path, segments=at_end)
+    np.testing.assert_allclose(result.error_um[at_end], iterative, rtol=0, atol=TOL_UM)

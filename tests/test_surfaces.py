@@ -49,11 +49,22 @@ def test_normals_are_unit_upward_and_normal_to_the_surface(index: int) -> None:
     np.testing.assert_allclose(p, surface.point(u, v), atol=0)
 
 
-def test_curve_matches_point() -> None:
-    surface = paper_surface(2)
+@pytest.mark.parametrize(
+    "surface",
+    [paper_surface(2), Sphere(20.0), Sphere(20.0, inside=True), Cylinder(15.0)],
+    ids=["bumps", "sphere", "sphere-inside", "cylinder"],
+)
+def test_curve_jet_is_the_point_and_its_u_derivatives(surface) -> None:
     rng = np.random.default_rng(0)
-    u, v = rng.random(40), rng.random(40)
-    np.testing.assert_allclose(surface.curve(v)(u), surface.point(u, v), rtol=0, atol=1e-12)
+    u, v = rng.uniform(0.01, 0.99, 40), rng.random(40)
+    jet = surface.curve_jet(v)
+    c, c_u, c_uu = jet(u)
+    np.testing.assert_allclose(c, surface.point(u, v), rtol=0, atol=1e-12)
+    h = 1e-5  # central differences: truncation error ~ h^2 times the next derivative / 6
+    (cp, cp_u, _), (cm, cm_u, _) = jet(u + h), jet(u - h)
+    scale = np.abs(c_u).max()
+    np.testing.assert_allclose(c_u, (cp - cm) / (2 * h), rtol=0, atol=1e-6 * scale)
+    np.testing.assert_allclose(c_uu, (cp_u - cm_u) / (2 * h), rtol=0, atol=1e-5 * scale)
 
 
 def test_papers_path_has_19800_segments_and_cl_is_r_along_the_normal() -> None:

@@ -44,6 +44,11 @@ __all__ = [
     "paper_surface",
 ]
 
+#: ``curve_jet(v)`` of a surface, for ``v`` of shape (n,): ``jet(u, rows=slice(None))`` gives
+#: the points :math:`c(u)`, :math:`c_u` and :math:`c_{uu}` of the iso-``v[rows]`` curves at ``u``
+#: (one per row), each shape (len(u), 3).
+CurveJet = Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]]
+
 
 def _check_positive(name: str, value: float) -> None:
     if not (np.isfinite(value) and value > 0):
@@ -152,23 +157,33 @@ class BumpSurface:
         c0, c1 = self._scale
         return np.stack([x, y, c0 + c1 * self._raw_value(x, y)], axis=-1)
 
-    def curve(self, v: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-        """Points of the iso-``v`` curves: ``curve(v)(u)`` is ``point(u, v)``, shape (n, 3), for
-        ``u`` and ``v`` of shape (n,). The y factors of the bumps are computed once."""
+    def curve_jet(self, v: np.ndarray) -> CurveJet:
+        r"""Points of the iso-``v`` curves and their first two derivatives in :math:`u`.
+
+        ``curve_jet(v)(u, rows)`` is ``(c, c_u, c_uu)`` (:data:`CurveJet`) with
+        :math:`c = (L_x u,\ L_y v,\ h)`, :math:`c_u = (L_x, 0, L_x h_x)` and
+        :math:`c_{uu} = (0, 0, L_x^2 h_{xx})`. The y factors of the bumps are computed once.
+        """
         v = np.asarray(v, float)
-        xk, yk, sx, sy, w = self._arrays
+        xk, yk, sx, sy, w = (a[:, None] for a in self._arrays)  # (bumps, 1): rows add fast
         y = v * self.size_y_mm
-        dy = (y[:, None] - yk) / sy
-        wy = w * np.exp(-0.5 * dy * dy)  # (n, bumps)
+        dy = (y - yk) / sy
+        wy = w * np.exp(-0.5 * dy * dy)  # (bumps, n)
         c0, c1 = self._scale
+        lx = self.size_x_mm
 
-        def points(u: np.ndarray) -> np.ndarray:
-            x = np.asarray(u, float) * self.size_x_mm
-            dx = (x[:, None] - xk) / sx
-            z = c0 + c1 * np.einsum("ij,ij->i", np.exp(-0.5 * dx * dx), wy)
-            return np.stack([x, y, z], axis=-1)
+        def jet(u: np.ndarray, rows=slice(None)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            x = np.asarray(u, float) * lx
+            slope = (x - xk) / (sx * sx)  # (bumps, n)
+            g = np.exp(-0.5 * (x - xk) * slope) * wy[:, rows]
+            gs = g * slope
+            c, c_u, c_uu = np.zeros((3, len(x), 3))
+            c[:, 0], c[:, 1], c[:, 2] = x, y[rows], c0 + c1 * g.sum(axis=0)
+            c_u[:, 0], c_u[:, 2] = lx, -lx * c1 * gs.sum(axis=0)
+            c_uu[:, 2] = lx * lx * c1 * (gs * slope - g / (sx * sx)).sum(axis=0)
+            return c, c_u, c_uu
 
-        return points
+        return jet
 
     def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points and upward unit normals, each shape ``(*u.shape, 3)``."""
@@ -223,9 +238,23 @@ class Sphere:
         """Surface points, shape ``(*u.shape, 3)``."""
         return self.point_normal(u, v)[0]
 
-    def curve(self, v: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-        """Points of the iso-``v`` curves: ``curve(v)(u)`` is ``point(u, v)``."""
-        return lambda u: self.point(u, v)
+    def curve_jet(self, v: np.ndarray) -> CurveJet:
+        r"""Iso-``v`` great-circle arcs: ``curve_jet(v)(u, rows)`` is :math:`(c, c_u, c_{uu})`
+        (:data:`CurveJet`), with :math:`c_u = \rho\,\Delta\theta\,\partial_\theta(\dots)` and
+        :math:`c_{uu} = -\Delta\theta^2 c`."""
+        phi = 2 * np.pi * np.asarray(v, float)
+        cos_phi, sin_phi = np.cos(phi), np.sin(phi)
+        rho, sweep = self.radius_mm, self.sweep_rad
+
+        def jet(u: np.ndarray, rows=slice(None)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            theta = self.theta0_rad + np.asarray(u, float) * sweep
+            st, ct = np.sin(theta), np.cos(theta)
+            cp, sp = cos_phi[rows], sin_phi[rows]
+            c = rho * np.stack([st * cp, st * sp, ct], axis=-1)
+            c_u = rho * sweep * np.stack([ct * cp, ct * sp, -st], axis=-1)
+            return c, c_u, -(sweep * sweep) * c
+
+        return jet
 
 
 @dataclass(frozen=True)
@@ -270,9 +299,23 @@ class Cylinder:
         """Surface points, shape ``(*u.shape, 3)``."""
         return self.point_normal(u, v)[0]
 
-    def curve(self, v: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-        """Points of the iso-``v`` curves: ``curve(v)(u)`` is ``point(u, v)``."""
-        return lambda u: self.point(u, v)
+    def curve_jet(self, v: np.ndarray) -> CurveJet:
+        r"""Iso-``v`` circular arcs: ``curve_jet(v)(u, rows)`` is :math:`(c, c_u, c_{uu})`
+        (:data:`CurveJet`), with
+        :math:`c_u = \rho\,\Delta\varphi\,(\cos\varphi, 0, -\sin\varphi)`."""
+        y = self.length_mm * np.asarray(v, float)
+        rho, sweep = self.radius_mm, self.sweep_rad
+
+        def jet(u: np.ndarray, rows=slice(None)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            phi = self.phi0_rad + np.asarray(u, float) * sweep
+            sp, cp = np.sin(phi), np.cos(phi)
+            zero = np.zeros_like(phi)
+            c = np.stack([rho * sp, y[rows] + zero, rho * cp], axis=-1)
+            c_u = rho * sweep * np.stack([cp, zero, -sp], axis=-1)
+            c_uu = -(rho * sweep * sweep) * np.stack([sp, zero, cp], axis=-1)
+            return c, c_u, c_uu
+
+        return jet
 
 
 Surface = BumpSurface | Sphere | Cylinder
