@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from nctwin.estimate import estimate
 from nctwin.gcode import parse
 from nctwin.kernel import linuxcnc as lc
 from nctwin.machine import load_machine
@@ -147,6 +148,27 @@ def test_exact_stop_at_corner():
     assert (m.block[: k - 5] == 0).all() and (m.block[k + 5 :] == 1).all()
     np.testing.assert_array_equal(m.pos_mm[-1], [30.0, 20.0, 0.0])
     assert m.speed_mm_s.max() <= 50.0 + SPEED_ROUNDING_MM_S
+
+
+#: Programs whose LinuxCNC cycle time the blend-arc planner (nctwin.estimate.blend_planner)
+#: must match: a parabolic straight-on blend and the last move at a / 2, a blend arc with the
+#: full acceleration on the line before it, a chain of short blended lines, and moves that turn
+#: back within 0.002 rad and stop.
+PLANNER_PROGRAMS = {
+    "collinear": "G21 G90 G64 P0.1\nG1 X30 F3000\nX60\nM2\n",
+    "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
+    "short_corners": "G21 G90 G64 P0.1\nG1 X10 F6000\nY10\nX20\nY20\nX30\nY30\nM2\n",
+    "reversals": "G21 G90 G64\nG1 X25.4 F6000\nX0 Y0.0254\nX25.4 Y0.0508\nX0 Y0.0762\nM2\n",
+}
+
+
+@live
+@pytest.mark.parametrize("name", sorted(PLANNER_PROGRAMS))
+def test_blend_planner_times_what_linuxcnc_records(name):
+    program = PLANNER_PROGRAMS[name]
+    recorded = lc.run(program, MACHINE).cycle_time_s
+    planned = estimate(parse(program, start_mm=(0, 0, 0)), MACHINE, "planner").cycle_time_s
+    assert planned == pytest.approx(recorded, abs=5 * PERIOD_S)
 
 
 @live
