@@ -36,9 +36,18 @@ def test_last_move_of_a_blending_program_brakes_at_half_acceleration():
     assert time_s("G21 G90\nG1 X60 F3000\n") == pytest.approx(1.3)
 
 
-def test_collinear_lines_blend_parabolically_at_full_speed():
-    # one parabolic blend straight on: both moves at a/2, no slow-down (LinuxCNC: 1.301 s)
-    assert time_s("G21 G90 G64 P0.1\nG1 X30 F3000\nX60\n") == pytest.approx(1.3)
+def test_collinear_lines_run_at_full_acceleration_into_the_last_move():
+    # 3 x 20 mm at 200 mm/s: up at a through the straight-on junction, down at a to the last
+    # move's triangle speed sqrt(a / 2 * 20) = 100 mm/s, then that move at a / 2 from 100 mm/s
+    # to its peak and to rest (LinuxCNC: 0.616 s)
+    v1, a2 = math.sqrt(A / 2 * 20), A / 2
+    cruise_mm = 40 - 200**2 / (2 * A) - (200**2 - v1**2) / (2 * A)
+    first_two = 200 / A + (200 - v1) / A + cruise_mm / 200
+    peak = math.sqrt((2 * a2 * 20 + v1**2) / 2)
+    last = (peak - v1) / a2 + peak / a2
+    program = "G21 G90 G64\nG1 X20 F12000\nX40\nX60\n"
+    assert first_two + last == pytest.approx(0.616, abs=0.002)
+    assert time_s(program) == pytest.approx(first_two + last)
 
 
 def test_corner_blend_arc():

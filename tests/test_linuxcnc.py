@@ -151,11 +151,11 @@ def test_exact_stop_at_corner():
 
 
 #: Programs whose LinuxCNC cycle time the blend-arc planner (nctwin.estimate.blend_planner)
-#: must match: a parabolic straight-on blend and the last move at a / 2, a blend arc with the
-#: full acceleration on the line before it, a chain of short blended lines, and moves that turn
-#: back within 0.002 rad and stop.
+#: must match: collinear lines at the full acceleration into a last move at a / 2, a blend arc
+#: with the full acceleration on the line before it, a chain of short blended lines, and moves
+#: that turn back within 0.002 rad and stop.
 PLANNER_PROGRAMS = {
-    "collinear": "G21 G90 G64 P0.1\nG1 X30 F3000\nX60\nM2\n",
+    "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
     "short_corners": "G21 G90 G64 P0.1\nG1 X10 F6000\nY10\nX20\nY20\nX30\nY30\nM2\n",
     "reversals": "G21 G90 G64\nG1 X25.4 F6000\nX0 Y0.0254\nX25.4 Y0.0508\nX0 Y0.0762\nM2\n",

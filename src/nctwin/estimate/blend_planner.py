@@ -30,28 +30,34 @@ Junction :math:`j` between moves of length :math:`L_1, L_2` with unit directions
   :math:`\pi` - 0.05 rad is blended (its source's own arc limit is 0.001 rad; what rejects
   the others is not modelled).
 
-Along a line the tangential acceleration is the full :math:`a` (LinuxCNC halves it only for a
-parabolic blend, ``tcGetOverallMaxAccel``), except on a move that keeps the parabolic end
-condition it was queued with while blending is on: the move that ends the program or runs into
-a dwell, and both moves of a straight-on junction, which LinuxCNC joins with a parabolic blend;
-these accelerate and brake at :math:`a/2`. Look-ahead: :math:`v_{j+1} \le \sqrt{v_j^2 + 2 a_k
-L_k}` forward and backward over lines and arcs. Segment time: the trapezoid (or triangle) from
-:math:`v_j` to :math:`v_{j+1}` under the feed; a move (its line and half of each of its arcs)
-takes at least one servo period (the planner completes at most one move per cycle). Arcs of the
-program are taken as chords (:func:`nctwin.realkernel.model_blocks`).
+Along a line the tangential acceleration is the full :math:`a`, through straight-on junctions
+too (LinuxCNC halves it only for a parabolic blend, ``tcGetOverallMaxAccel``), except on a move
+that keeps the parabolic end condition it was queued with while blending is on: the move that
+ends the program or runs into a dwell. That move accelerates and brakes at :math:`a/2`, and it
+is entered at most at its triangle speed :math:`\sqrt{a L / 2}`.
+Look-ahead: :math:`v_{j+1} \le \sqrt{v_j^2 + 2 a_k L_k}` forward and backward over lines and
+arcs. Segment time: the trapezoid (or triangle) from :math:`v_j` to :math:`v_{j+1}` under the
+feed; a move (its line and half of each of its arcs) takes at least one servo period (the
+planner completes at most one move per cycle). Arcs of the program are taken as chords
+(:func:`nctwin.realkernel.model_blocks`).
 
 Measured on LinuxCNC (``linuxcnc_sim``, recorded live; model in brackets): one 60 mm line at
-50 mm/s in the default ``G64``: 1.301 s (1.300), the same as two collinear 30 mm lines (1.300); a
-90° corner of two 100 mm lines at 50 mm/s, ``G64 P0.1``: 4.131 s (4.130), with a 0.5 s dwell
-instead of the blend: 4.704 s (4.700), under ``G61``: 4.113 s (4.100); six 10 mm lines with 90°
-corners at 100 mm/s, ``G64 P0.1``: 1.244 s (1.242); 120° and 90° corners at 150 mm/s,
-``G64 P0.5``: 1.082 s (1.080); four 25.4 mm moves that turn back within 0.002 rad, plain
-``G64``: 1.519 s (1.516). The recorded speed traces show the full acceleration on lines between
-arcs and stops, the arc speed :math:`v_j`, and :math:`a/2` on the last move. The live tests of
-:mod:`nctwin.kernel.linuxcnc` check four of these.
+50 mm/s in the default ``G64``: 1.301 s (1.300); a 90° corner of two 100 mm lines at 50 mm/s,
+``G64 P0.1``: 4.131 s (4.130), with a 0.5 s dwell instead of the blend: 4.704 s (4.700), under
+``G61``: 4.113 s (4.100); six 10 mm lines with 90° corners at 100 mm/s, ``G64 P0.1``: 1.244 s
+(1.242); 120° and 90° corners at 150 mm/s, ``G64 P0.5``: 1.082 s (1.080); four 25.4 mm moves
+that turn back within 0.002 rad, plain ``G64``: 1.519 s (1.516); collinear chains at 200 mm/s,
+plain ``G64``: 300 x 1 mm 1.740 s (1.739), 10 x 5 mm 0.528 s (0.526), 3 x 20 mm 0.616 s
+(0.615). The recorded speed traces show the full acceleration on lines, through straight-on
+junctions, into arcs and stops, the arc speed :math:`v_j`, and :math:`a/2` on the last move,
+entered at its triangle speed. The model misses two collinear lines (1.301 s, model 1.275: LinuxCNC
+runs the first at :math:`a/2` too) and 300 collinear 0.2 mm lines (0.584 s, model 0.519:
+LinuxCNC holds 142 mm/s on them, not 200). The live tests of :mod:`nctwin.kernel.linuxcnc`
+check four of these programs.
 
 Not modelled: the naive-CAM merging of ``G64 Q``, the parabolic blends LinuxCNC falls back to
-where no arc fits, and the arc blends between circular moves.
+where no arc fits, the arc blends between circular moves, and what limits the speed on chains of
+moves a few servo periods long.
 """
 
 from __future__ import annotations
@@ -89,8 +95,8 @@ def junction_blends(
     feed_mm_s: np.ndarray,
     acc_mm_s2: np.ndarray,
     tol_mm: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Blends at the junctions of M moves: speed limit, consumed length, arc length, parabolic.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Blend arcs at the junctions of M moves: speed limit, consumed length and arc length.
 
     Parameters
     ----------
@@ -110,9 +116,6 @@ def junction_blends(
         (0 where no arc is made).
     arc_mm : ndarray, shape (M - 1,)
         Length of the blend arc (0 where none is made).
-    parabolic : ndarray of bool, shape (M - 1,)
-        Straight-on junctions while blending is on: LinuxCNC joins them with a parabolic blend,
-        at full speed, and both moves accelerate at :math:`a/2`.
     """
     l1, l2 = length_mm[:-1], length_mm[1:]
     p = tol_mm[1:]
@@ -131,7 +134,7 @@ def junction_blends(
     v = np.where((p > 0) & (2.0 * theta >= STOP_TURN_RAD), v, 0.0)
     arc = (v > 0) & ~straight
     arc_radius = np.where(arc, radius, 0.0)
-    return v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), (p > 0) & straight
+    return v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta)
 
 
 def segment_times(
@@ -196,17 +199,17 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     parabolic_end[-1] = True
     parabolic_end &= tol > 0
     tol[after[after < len(moves)]] = 0.0
-    v, d, arc, parabolic = junction_blends(length, moves.directions, feed, acc, tol)
-    half_acc = (
-        parabolic_end | np.concatenate([parabolic, [False]]) | np.concatenate([[False], parabolic])
-    )
+    v, d, arc = junction_blends(length, moves.directions, feed, acc, tol)
+    # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed
+    a_line = acc * np.where(parabolic_end, TANGENTIAL_ACC_RATIO, 1.0)
+    v = np.where(parabolic_end[1:], np.minimum(v, np.sqrt(a_line * length)[1:]), v)
     # the chain line 0, arc 0, line 1, ..., line M-1, with the arcs of unblended junctions empty
     m = len(moves)
     seg_len = np.empty(2 * m - 1)
     seg_len[0::2] = length - np.concatenate([[0.0], d]) - np.concatenate([d, [0.0]])
     seg_len[1::2] = arc
     seg_acc = np.empty(2 * m - 1)
-    seg_acc[0::2] = acc * np.where(half_acc, TANGENTIAL_ACC_RATIO, 1.0)
+    seg_acc[0::2] = a_line
     seg_acc[1::2] = TANGENTIAL_ACC_RATIO * np.minimum(acc[:-1], acc[1:])
     seg_feed = np.empty(2 * m - 1)
     seg_feed[0::2] = feed
