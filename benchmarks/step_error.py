@@ -1,7 +1,7 @@
 """Speed of the step error of one Zhang et al. 2023 surface (surface 2: 200 lines x 100 CC
 points, 19,800 CL segments, R = 5 mm), three ways:
 
-* ``step_error_exact_vectorised_s``: the exact golden-section method on all segments at once
+* ``step_error_exact_vectorised_s``: the exact (Newton) method on all segments at once
   (target < 0.1 s; the paper's geometric method: 9.27 s);
 * ``step_error_iterative_s``: the per-segment Brent loop, timed on every 20th segment and scaled
   to 19,800 (no target: the baseline);
