@@ -71,7 +71,7 @@ class StepError:
     convex: np.ndarray
 
 
-CL_CC = (("cl0", "cc0"), ("cl1", "cc1"))
+_CL_CC = (("cl0", "cc0"), ("cl1", "cc1"))  # the CL and CC keys of both segment ends
 
 
 def _along(points: np.ndarray, cl0: np.ndarray, axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -100,8 +100,8 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4, max_steps: int = 60) ->
     step that leaves it, or is taken where :math:`F'' \le 0`, is replaced by bisection. It stops
     when every segment's last step is at most ``xtol`` of its interval; the value at the end of
     that step is the second-order Taylor expansion of :math:`F` from its start (an error of the
-    order of the step cubed, no further evaluation). With :math:`w = c - CL_i`
-    and the unit CL direction :math:`a`,
+    order of the step cubed, no further evaluation). With :math:`w = c - CL_i` and the unit CL
+    direction :math:`a`,
 
     .. math:: \tfrac12 (d^2)' = w \cdot c_u - (w \cdot a)(a \cdot c_u), \qquad
               \tfrac12 (d^2)'' = c_u \cdot c_u + w \cdot c_{uu} - (a \cdot c_u)^2
@@ -157,7 +157,7 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4, max_steps: int = 60) ->
     # near an inflection) the extreme is taken at an end or the middle.
     falls_a, rises_b = (
         sign * s * np.einsum("ij,ij->i", seg[cl] - seg[cc], axis) > 0.0
-        for s, (cl, cc) in zip((-1.0, 1.0), CL_CC, strict=True)
+        for s, (cl, cc) in zip((-1.0, 1.0), _CL_CC, strict=True)
     )
     a, b, stop = u0.copy(), u1.copy(), xtol * (u1 - u0)
     f = np.empty(path.n_segments)  # F where the iteration ends
