@@ -5,8 +5,10 @@ Targets: at least 10 million output samples per second; the pocket in under 0.3 
 throughput is end to end: output samples over the wall time of ``fir.run(toolpath, machine)``
 (planning included), best of 5, each run on a fresh copy of the parsed tool path so that no
 property the tool path caches (lengths, tangents) is reused between runs. Per stage, on the
-pocket: ``kernel_pocket5000_plan_s`` times the look-ahead (``fir.plan``) alone and
-``kernel_filter_samples_per_s`` the O(n) filter stage alone (``FirFilter.apply``).
+pocket: ``kernel_pocket5000_plan_s`` times the look-ahead (``fir.plan``) alone,
+``kernel_sample_stage_samples_per_s`` divides the output samples by what the run takes beyond
+the plan (the speed command, sampling it, the filters and the axis-limit passes) and
+``kernel_filter_samples_per_s`` times the O(n) filter stage alone (``FirFilter.apply``).
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ def main() -> None:
     record("kernel_pocket5000_s", round(t, 4), "s", "< 0.3")
     tplan = cold_time_s(lambda tp: fir.plan(tp, machine), pocket)
     record("kernel_pocket5000_plan_s", round(tplan, 4), "s", "")
+    record("kernel_sample_stage_samples_per_s", round(samples / (t - tplan)), "samples/s", "")
     x = fir.run(pocket, machine).pos_mm.T.copy()  # (3, n) samples to filter
     flt = fir.FirFilter.of(machine)
     tf = best_time_s(lambda: flt.apply(x), repeat=REPEAT, warmup=1)

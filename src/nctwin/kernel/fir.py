@@ -47,6 +47,7 @@ from ..geometry import PathGeometry
 from ..machine import MachineProfile
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
+from . import _fir_loops
 
 __all__ = ["FirFilter", "corner_deviation_mm", "plan", "run"]
 
@@ -117,31 +118,17 @@ class FirFilter:
         Returns shape (3, n + n1 + n2 - 2), the transpose of a C-contiguous (n + n1 + n2 - 2, 3)
         array: the input is held at its first and last value outside its span. Each box is a
         difference of running sums, O(n); the sums run over positions relative to the start,
-        which keeps their rounding below 1e-7 mm. Two buffers are reused across the boxes.
+        which keeps their rounding below 1e-7 mm.
         """
-        x0 = x[:, 0]
-        taps = [n for n in self.taps if n > 1]
-        m = x.shape[1]
-        size = m + sum(taps) - len(taps)
+        return self._apply_rows(np.ascontiguousarray(x.T)).T
+
+    def _apply_rows(self, x: np.ndarray) -> np.ndarray:
+        """:meth:`apply` on sample-major positions, (n, 3) C-contiguous, to (n', 3)."""
+        taps = np.array([n for n in self.taps if n > 1], dtype=np.int64)
+        size = len(x) + int(taps.sum()) - len(taps)
         cur, other = np.empty((size, 3)), np.empty((size, 3))
-        np.subtract(x.T, x0, out=cur[:m])
-        for n in taps:
-            # running sum of the input held at its last value for n - 1 more samples ...
-            c = other
-            np.cumsum(cur[:m], axis=0, out=c[:m])
-            tail = np.empty((n, 3))
-            tail[0] = c[m - 1]
-            tail[1:] = cur[m - 1]
-            np.cumsum(tail, axis=0, out=tail)
-            c[m : m + n - 1] = tail[1:]
-            # ... minus the sum n samples earlier (zero before the start), over n
-            k = m + n - 1
-            cur[:n] = c[:n]
-            np.subtract(c[n:k], c[: k - n], out=cur[n:k])
-            cur[:k] /= n
-            m = k
-        cur += x0
-        return cur.T
+        _fir_loops.box_cascade(x, taps, cur, other)
+        return cur
 
 
 def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
@@ -496,12 +483,10 @@ def _interpolate(tp, fir: FirFilter, t_knots, x_knots):
     Returns the filtered positions, shape (n, 3), and the filter lag in samples."""
     ts = fir.period_s
     n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
-    t_cmd = np.arange(n_cmd) * ts
     x = np.empty((n_cmd, 3))
-    for a in range(3):
-        x[:, a] = np.interp(t_cmd, t_knots, x_knots[:, a])
+    _fir_loops.sample_command(n_cmd, ts, t_knots, np.ascontiguousarray(x_knots), x)
     x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
-    pos = fir.apply(x.T).T
+    pos = fir._apply_rows(x)
     n1, n2 = fir.taps
     lag = n1 + n2 - 2
     # the filter's sums of equal values carry rounding: rest is exact at both ends
@@ -511,43 +496,28 @@ def _interpolate(tp, fir: FirFilter, t_knots, x_knots):
     return pos, lag
 
 
-def _velocity(pos: np.ndarray, ts: float) -> np.ndarray:
-    """Axis velocities (n, 3) of positions ``pos`` (n, 3): backward differences, 0 first."""
+def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray):
+    """Axis velocities of ``pos`` (n, 3), and the largest ratio of axis velocity, acceleration
+    and jerk to their limits (3, 3) per sample.
+
+    Derivatives are backward differences, velocity 0 at the first sample. Returns the
+    velocities (n, 3) and the ratios, shape (n,), or None when no sample exceeds a limit (the
+    common case, checked first on the peaks of one compiled pass)."""
     vel = np.empty_like(pos)
-    vel[:1] = 0.0
-    np.subtract(pos[1:], pos[:-1], out=vel[1:])
-    vel[1:] /= ts
-    return vel
-
-
-def _limit_ratio(vel: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray | None:
-    """Largest ratio of axis velocity, acceleration and jerk to their limits, per sample.
-
-    ``vel`` is (n, 3), from :func:`_velocity`; derivatives are backward differences. Returns
-    shape (n,), or None when no sample exceeds a limit (the common case, checked first on the
-    maxima)."""
+    peak = _fir_loops.derivative_peaks(pos, ts, vel)
+    over = np.argwhere(peak > limits * (1.0 + LIMIT_RTOL))  # (order, axis) above the limit
+    if not len(over):
+        return vel, None
     derivs = [vel[1:]]
     for _ in range(2):
         d = np.diff(derivs[-1], axis=0)
         d /= ts
         derivs.append(d)
-    over = []  # (order, axis) of the derivatives above their limit
-    for order, d in enumerate(derivs):
-        bound = limits[order] * (1.0 + LIMIT_RTOL)
-        # whole-array extremes are fast; per axis only where some axis may exceed its limit
-        if np.maximum(d.max(initial=0.0), -d.min(initial=0.0)) <= bound.min():
-            continue
-        for a in range(3):
-            col = d[:, a]
-            if np.maximum(col.max(initial=0.0), -col.min(initial=0.0)) > bound[a]:
-                over.append((order, a))
-    if not over:
-        return None
     ratio = np.zeros(len(vel))
     for order, a in over:
         r = np.abs(derivs[order][:, a]) / limits[order, a]
         np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
-    return ratio
+    return vel, ratio
 
 
 def _moves(tp: Toolpath) -> np.ndarray:
@@ -602,8 +572,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     for _ in range(MAX_SLOWDOWNS + 1):
         t_knots = cmd.knot_times(scale)
         pos, lag = _interpolate(tp, fir, _refined(t_knots, refinement), x_knots)
-        vel = _velocity(pos, ts)
-        ratio = _limit_ratio(vel, ts, limits)
+        vel, ratio = _limit_ratio(pos, ts, limits)
         if ratio is None:
             break
         # slow the command over the windows that made the violating samples

@@ -1,0 +1,111 @@
+"""Compiled sample loops of the FIR kernel (numba): sampling the command, the box cascade and the
+axis-limit extremes, one pass over the samples each.
+
+Each loop performs the same floating-point operations, in the same order, as the numpy code it
+replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``), so the kernel's output
+does not depend on which one ran; ``tests/test_fir_loops.py`` checks this bit for bit. numba
+compiles them on first use and caches the machine code beside this file.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["box_cascade", "derivative_peaks", "sample_command"]
+
+
+@njit(cache=True)
+def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover - compiled
+    """Positions of a piecewise-linear command at ``i * period_s``, ``i < n_cmd``.
+
+    ``t_knots`` (K,) non-decreasing from 0, ``x_knots`` (K, 3); writes ``out`` (n_cmd, 3). The same
+    arithmetic as ``np.interp`` per axis (value at a knot exactly, ``slope * (t - t_j) + x_j``
+    inside, the last value at and after the last knot); the knot search walks forward, as the
+    sample times increase.
+    """
+    k = len(t_knots)
+    j = 0
+    for i in range(n_cmd):
+        t = i * period_s
+        while j + 1 < k and t_knots[j + 1] <= t:
+            j += 1
+        if j == k - 1:
+            for a in range(3):
+                out[i, a] = x_knots[k - 1, a]
+        elif t_knots[j] == t:
+            for a in range(3):
+                out[i, a] = x_knots[j, a]
+        else:
+            dt = t_knots[j + 1] - t_knots[j]
+            for a in range(3):
+                slope = (x_knots[j + 1, a] - x_knots[j, a]) / dt
+                v = slope * (t - t_knots[j]) + x_knots[j, a]
+                if np.isnan(v):
+                    v = slope * (t - t_knots[j + 1]) + x_knots[j + 1, a]
+                    if np.isnan(v) and x_knots[j, a] == x_knots[j + 1, a]:
+                        v = x_knots[j, a]
+                out[i, a] = v
+
+
+@njit(cache=True)
+def box_cascade(x, taps, cur, other):  # pragma: no cover - compiled
+    """Moving averages of ``taps`` (each > 1) in cascade over ``x`` (m, 3), held at its last
+    value past its end, as :meth:`nctwin.kernel.fir.FirFilter.apply`: running sums of the
+    positions relative to the first, differenced ``n`` apart, over ``n``.
+
+    ``cur`` and ``other`` are (m + sum(taps) - len(taps), 3) buffers; the result is in ``cur``.
+    """
+    m = x.shape[0]
+    for i in range(m):
+        for a in range(3):
+            cur[i, a] = x[i, a] - x[0, a]
+    for n in taps:
+        c = other
+        for a in range(3):
+            c[0, a] = cur[0, a]
+        for i in range(1, m):
+            for a in range(3):
+                c[i, a] = c[i - 1, a] + cur[i, a]
+        for i in range(m, m + n - 1):
+            for a in range(3):
+                c[i, a] = c[i - 1, a] + cur[m - 1, a]
+        k = m + n - 1
+        for i in range(k):
+            for a in range(3):
+                s = c[i, a] if i < n else c[i, a] - c[i - n, a]
+                cur[i, a] = s / n
+        m = k
+    for i in range(m):
+        for a in range(3):
+            cur[i, a] += x[0, a]
+
+
+@njit(cache=True)
+def derivative_peaks(pos, period_s, vel):  # pragma: no cover - compiled
+    """Axis velocities and the largest magnitude of velocity, acceleration and jerk per axis.
+
+    ``pos`` (n, 3); writes ``vel`` (n, 3), backward differences with ``vel[0] = 0``; returns
+    (3, 3): row = derivative order (velocity from sample 1 on, acceleration, jerk as
+    successive backward differences over the period), column = axis.
+    """
+    n = pos.shape[0]
+    peak = np.zeros((3, 3))
+    for a in range(3):
+        vel[0, a] = 0.0
+    for i in range(1, n):
+        for a in range(3):
+            vel[i, a] = (pos[i, a] - pos[i - 1, a]) / period_s
+            v = abs(vel[i, a])
+            if v > peak[0, a]:
+                peak[0, a] = v
+            if i >= 2:
+                acc = (vel[i, a] - vel[i - 1, a]) / period_s
+                if abs(acc) > peak[1, a]:
+                    peak[1, a] = abs(acc)
+                if i >= 3:
+                    acc0 = (vel[i - 1, a] - vel[i - 2, a]) / period_s
+                    jerk = (acc - acc0) / period_s
+                    if abs(jerk) > peak[2, a]:
+                        peak[2, a] = abs(jerk)
+    return peak

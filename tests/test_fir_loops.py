@@ -1,0 +1,71 @@
+"""The compiled sample loops of the FIR kernel compute the same bits as the numpy they replace."""
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from nctwin.kernel import _fir_loops
+
+PERIOD_S = 0.001
+
+
+def _numpy_filter(x: np.ndarray, taps: list[int]) -> np.ndarray:
+    """The box cascade with numpy's running sums: ``x`` (m, 3) held at its last value."""
+    cur = x - x[0]
+    for n in taps:
+        held = np.concatenate([cur, np.repeat(cur[-1:], n - 1, axis=0)])
+        c = np.cumsum(held, axis=0)
+        out = c.copy()
+        out[n:] = c[n:] - c[:-n]
+        cur = out / n
+    return cur + x[0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    m=st.integers(2, 400),
+    taps=st.lists(st.integers(2, 60), min_size=1, max_size=2),
+)
+def test_box_cascade_equals_numpy_running_sums(seed, m, taps):
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.normal(size=(m, 3)), axis=0) + rng.uniform(-500, 500, 3)
+    size = m + sum(taps) - len(taps)
+    cur, other = np.empty((size, 3)), np.empty((size, 3))
+    _fir_loops.box_cascade(x, np.array(taps, dtype=np.int64), cur, other)
+    np.testing.assert_array_equal(cur, _numpy_filter(x, taps))
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), k=st.integers(2, 60), pauses=st.booleans())
+def test_sample_command_equals_np_interp(seed, k, pauses):
+    # knot times as the kernel makes them: arrival and departure, equal where no pause
+    rng = np.random.default_rng(seed)
+    dur = rng.exponential(0.01, k)
+    hold = np.where(rng.random(k) < 0.3, rng.exponential(0.005, k), 0.0) if pauses else 0.0
+    steps = np.column_stack([np.broadcast_to(hold, (k,)), dur]).ravel()[:-1]  # pause, move, ...
+    t_knots = np.concatenate([[0.0], np.cumsum(steps)])
+    x_knots = np.repeat(np.cumsum(rng.normal(size=(k, 3)), axis=0), 2, axis=0)
+    x_knots[1::2] += rng.normal(0, 1e-3, (k, 3)) * (rng.random((k, 1)) < 0.5)
+    n_cmd = int(np.ceil(t_knots[-1] / PERIOD_S)) + 1
+    out = np.empty((n_cmd, 3))
+    _fir_loops.sample_command(n_cmd, PERIOD_S, t_knots, x_knots, out)
+    t = np.arange(n_cmd) * PERIOD_S
+    expected = np.column_stack([np.interp(t, t_knots, x_knots[:, a]) for a in range(3)])
+    np.testing.assert_array_equal(out, expected)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300))
+def test_derivative_peaks_equal_numpy_differences(seed, n):
+    rng = np.random.default_rng(seed)
+    pos = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    vel = np.empty_like(pos)
+    peak = _fir_loops.derivative_peaks(pos, PERIOD_S, vel)
+    expected_vel = np.zeros_like(pos)
+    expected_vel[1:] = (pos[1:] - pos[:-1]) / PERIOD_S
+    np.testing.assert_array_equal(vel, expected_vel)
+    acc = np.diff(expected_vel[1:], axis=0) / PERIOD_S
+    jerk = np.diff(acc, axis=0) / PERIOD_S
+    for order, d in enumerate([expected_vel[1:], acc, jerk]):
+        np.testing.assert_array_equal(peak[order], np.abs(d).max(axis=0, initial=0.0))
