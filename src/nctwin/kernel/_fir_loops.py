@@ -49,36 +49,44 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
 
 
 @njit(cache=True)
-def box_cascade(x, taps, cur, other):  # pragma: no cover - compiled
-    """Moving averages of ``taps`` (each > 1) in cascade over ``x`` (m, 3), held at its last
-    value past its end, as :meth:`nctwin.kernel.fir.FirFilter.apply`: running sums of the
-    positions relative to the first, differenced ``n`` apart, over ``n``.
+def box_cascade(x, taps, out):  # pragma: no cover - compiled
+    """Moving averages of ``taps`` (at least one, each > 1) in cascade over ``x`` (m, 3), held
+    at its last value past its end, as :meth:`nctwin.kernel.fir.FirFilter.apply`: running sums
+    of the positions relative to the first, differenced ``n`` apart, over ``n``.
 
-    ``cur`` and ``other`` are (m + sum(taps) - len(taps), 3) buffers; the result is in ``cur``.
+    ``x`` may be any 2-D view; ``out`` is (m + sum(taps) - len(taps), 3). Each stage runs in
+    place in ``out``; the last ``n`` running sums are kept in a ring, so no other buffer of
+    the signal's size is made.
     """
     m = x.shape[0]
+    ring = np.empty((taps.max(), 3))
+    x0 = np.empty(3)
+    last = np.empty(3)
+    total = np.zeros(3)
+    for a in range(3):
+        x0[a] = x[0, a]
+    for stage in range(len(taps)):
+        n = taps[stage]
+        for a in range(3):
+            last[a] = x[m - 1, a] - x0[a] if stage == 0 else out[m - 1, a]
+        for i in range(m + n - 1):
+            slot = i % n
+            for a in range(3):
+                if i >= m:
+                    v = last[a]
+                elif stage == 0:
+                    v = x[i, a] - x0[a]
+                else:
+                    v = out[i, a]
+                c = v if i == 0 else total[a] + v
+                total[a] = c
+                s = c if i < n else c - ring[slot, a]
+                ring[slot, a] = c
+                out[i, a] = s / n
+        m += n - 1
     for i in range(m):
         for a in range(3):
-            cur[i, a] = x[i, a] - x[0, a]
-    for n in taps:
-        c = other
-        for a in range(3):
-            c[0, a] = cur[0, a]
-        for i in range(1, m):
-            for a in range(3):
-                c[i, a] = c[i - 1, a] + cur[i, a]
-        for i in range(m, m + n - 1):
-            for a in range(3):
-                c[i, a] = c[i - 1, a] + cur[m - 1, a]
-        k = m + n - 1
-        for i in range(k):
-            for a in range(3):
-                s = c[i, a] if i < n else c[i, a] - c[i - n, a]
-                cur[i, a] = s / n
-        m = k
-    for i in range(m):
-        for a in range(3):
-            cur[i, a] += x[0, a]
+            out[i, a] += x0[a]
 
 
 @njit(cache=True)

@@ -120,15 +120,14 @@ class FirFilter:
         difference of running sums, O(n); the sums run over positions relative to the start,
         which keeps their rounding below 1e-7 mm.
         """
-        return self._apply_rows(np.ascontiguousarray(x.T)).T
+        return self._apply_rows(x.T).T
 
     def _apply_rows(self, x: np.ndarray) -> np.ndarray:
-        """:meth:`apply` on sample-major positions, (n, 3) C-contiguous, to (n', 3)."""
+        """:meth:`apply` on sample-major positions, (n, 3), to (n', 3) C-contiguous."""
         taps = np.array([n for n in self.taps if n > 1], dtype=np.int64)
-        size = len(x) + int(taps.sum()) - len(taps)
-        cur, other = np.empty((size, 3)), np.empty((size, 3))
-        _fir_loops.box_cascade(x, taps, cur, other)
-        return cur
+        out = np.empty((len(x) + int(taps.sum()) - len(taps), 3))
+        _fir_loops.box_cascade(x, taps, out)
+        return out
 
 
 def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
