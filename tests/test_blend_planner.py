@@ -4,15 +4,24 @@ test in test_linuxcnc.py checks the planner against LinuxCNC itself)."""
 
 import math
 
+import numpy as np
 import pytest
 
 from nctwin.estimate import estimate
-from nctwin.estimate.blend_planner import NORMAL_ACC_RATIO, STOP_TURN_RAD
+from nctwin.estimate.blend_planner import (
+    MIN_SEGMENT_CYCLES,
+    NORMAL_ACC_RATIO,
+    OPTIMIZATION_DEPTH,
+    STOP_TURN_RAD,
+    blend_plane_acc,
+    depth_limits,
+)
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
 
 MACHINE = load_machine("linuxcnc_sim")  # X/Y 1000 mm/s^2, Z 500 mm/s^2, 1 ms
 A = 1000.0  # path acceleration along X or Y
+AXIS_ACC = np.array([1000.0, 1000.0, 500.0])
 
 
 def time_s(program: str) -> float:
@@ -92,3 +101,69 @@ def test_a_move_takes_at_least_one_period():
     # 100 moves of 0.01 mm at 200 mm/s: at least 1 ms each
     moves = "\n".join(f"X{0.01 * (i + 1):.2f}" for i in range(100))
     assert time_s(f"G21 G90 G64\nG1 F12000\n{moves}\n") >= 100 * 0.001
+
+
+def test_an_item_runs_at_most_its_length_per_1_02_periods():
+    # 300 collinear moves of 0.05 mm at 200 mm/s: each item holds 0.05 mm / 1.02 ms = 49.02 mm/s
+    # (TP_MIN_SEGMENT_CYCLES; LinuxCNC: 0.364 s, cruising at 49.02 mm/s)
+    moves = "".join(f"X{0.05 * k:.2f}\n" for k in range(1, 301))
+    cruise = 0.05 / (MIN_SEGMENT_CYCLES * 0.001)
+    assert cruise == pytest.approx(49.02, abs=0.01)
+    assert time_s(f"G21 G90 G64\nG1 F12000\n{moves}") == pytest.approx(0.364, abs=0.002)
+
+
+def test_look_ahead_reaches_fifty_items():
+    # equal items: the end of each may be no faster than it can brake over the next 50 items at
+    # a and the 51st, still parabolic, at a / 2: v^2 = 2 a L (50 + 1/4)
+    length, acc = np.full(120, 0.2), np.full(120, A)
+    v = depth_limits(length, acc)
+    assert v[0] == pytest.approx(math.sqrt(2 * A * 0.2 * (OPTIMIZATION_DEPTH + 0.25)))
+    assert np.isinf(v[-OPTIMIZATION_DEPTH - 1 :]).all()
+    # 300 x 0.2 mm at 200 mm/s cruise at 141.8 mm/s (LinuxCNC: 0.583 s, 142 mm/s)
+    moves = "".join(f"X{0.2 * k:.1f}\n" for k in range(1, 301))
+    assert time_s(f"G21 G90 G64\nG1 F12000\n{moves}") == pytest.approx(0.583, abs=0.002)
+
+
+def test_blend_arcs_take_the_acceleration_of_their_plane():
+    s = math.sqrt(0.5)
+    xy = blend_plane_acc(np.array([[s, s, 0.0]]), np.array([[s, -s, 0.0]]), AXIS_ACC)
+    xz = blend_plane_acc(np.array([[s, 0.0, s]]), np.array([[s, 0.0, -s]]), AXIS_ACC)
+    straight = blend_plane_acc(np.array([[1.0, 0, 0]]), np.array([[1.0, 0, 0]]), AXIS_ACC)
+    # not the 1414 mm/s^2 a diagonal line may use: the X and Y limits, and Z's in a plane with Z
+    assert xy[0] == pytest.approx(1000.0)
+    assert xz[0] == pytest.approx(500.0)
+    assert np.isinf(straight[0])
+    # zigzags of 45 deg moves (LinuxCNC: 2.237 s in XY at P0.5, 1.109 s in XZ)
+    h = 5 / math.sqrt(2)
+    zig = "".join(f"X{h * k:.6f} Y{h * (k % 2):.6f}\n" for k in range(1, 21))
+    assert time_s(f"G21 G90 G64 P0.5\nG1 F6000\n{zig}") == pytest.approx(2.237, abs=0.002)
+    h = 1 / math.sqrt(2)
+    zig = "".join(f"X{h * k:.6f} Z{-h * (k % 2):.6f}\n" for k in range(1, 21))
+    assert time_s(f"G21 G90 G64\nG1 F6000\n{zig}") == pytest.approx(1.109, abs=0.002)
+
+
+def test_a_rapid_and_a_feed_move_are_not_blended():
+    # the tool stops between them (tpCheckCanonType): 10 mm rapid as a triangle at a,
+    # 2 sqrt(L / a) = 0.2 s; then the last move from rest at a / 2: 2 sqrt(L / (a / 2)) = 0.283 s
+    # (LinuxCNC: 0.483 s)
+    expected = 2 * math.sqrt(10 / A) + 2 * math.sqrt(10 / (A / 2))
+    assert time_s("G21 G90 G64\nG0 X10\nG1 X20 F6000\n") == pytest.approx(expected)
+    assert expected == pytest.approx(0.483, abs=0.001)
+
+
+def test_an_arc_is_one_move_under_its_centripetal_limit():
+    # quarter circle r = 10 in G61 at 100 mm/s: the speed stays within sqrt(0.866 a r) = 93.1
+    # mm/s, the tangential acceleration is a / 2; the arc is too short to reach it: a triangle
+    # 2 sqrt(L / (a / 2)) with L = 5 pi (LinuxCNC: 0.355 s)
+    expected = 2 * math.sqrt(5 * math.pi / (A / 2))
+    assert time_s("G21 G90 G61\nG2 X10 Y-10 I0 J-10 F6000\n") == pytest.approx(expected)
+    assert expected == pytest.approx(0.355, abs=0.001)
+
+
+def test_naive_cam_merging_before_planning():
+    # G64 P0.01 sets Q = P: 200 moves wiggling 0.004 mm about a line are planned as the two
+    # lines LinuxCNC's canon makes of them (101 points, then 99; with Q0 nothing is merged)
+    wiggle = "".join(f"X{0.05 * k:.2f} Y{0.004 * (k % 2):.3f}\n" for k in range(1, 201))
+    merged = "G21 G90 G64 P0.01 Q0\nG1 F6000\nX5.05 Y0.004\nX10 Y0\n"
+    assert time_s("G21 G90 G64 P0.01\nG1 F6000\n" + wiggle) == pytest.approx(time_s(merged))
+    assert time_s(merged) < 0.5 * time_s("G21 G90 G64 P0.01 Q0\nG1 F6000\n" + wiggle)

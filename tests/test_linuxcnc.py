@@ -152,13 +152,22 @@ def test_exact_stop_at_corner():
 
 #: Programs whose LinuxCNC cycle time the blend-arc planner (nctwin.estimate.blend_planner)
 #: must match: collinear lines at the full acceleration into a last move at a / 2, a blend arc
-#: with the full acceleration on the line before it, a chain of short blended lines, and moves
-#: that turn back within 0.002 rad and stop.
+#: with the full acceleration on the line before it, a chain of short blended lines, moves
+#: that turn back within 0.002 rad and stop, 300 moves of 0.2 mm held back by the look-ahead's
+#: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), and a rapid followed
+#: by a feed move (no blend between them).
 PLANNER_PROGRAMS = {
     "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
     "short_corners": "G21 G90 G64 P0.1\nG1 X10 F6000\nY10\nX20\nY20\nX30\nY30\nM2\n",
     "reversals": "G21 G90 G64\nG1 X25.4 F6000\nX0 Y0.0254\nX25.4 Y0.0508\nX0 Y0.0762\nM2\n",
+    "depth": "G21 G90 G64\nG1 F12000\n"
+    + "".join(f"X{0.2 * k:.1f}\n" for k in range(1, 301))
+    + "M2\n",
+    "xz_zigzag": "G21 G90 G64\nG1 F6000\n"
+    + "".join(f"X{k / 2**0.5:.6f} Z{-(k % 2) / 2**0.5:.6f}\n" for k in range(1, 21))
+    + "M2\n",
+    "rapid_feed": "G21 G90 G64\nG0 X10\nG1 X20 F6000\nM2\n",
 }
 
 

@@ -45,7 +45,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from .estimate import Estimate, block_overlap, cam, kernel
-from .estimate.blend_planner import blend_planner
+from .estimate.blend_planner import blend_planner, move_limits
 from .features import BlockTargets, sun2022_features
 from .geometry import PathGeometry
 from .machine import MachineProfile
@@ -144,19 +144,6 @@ def model_blocks(tp: Toolpath) -> tuple[Toolpath, np.ndarray]:
     return moves, source
 
 
-def _move_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, np.ndarray]:
-    """Feed (programmed, or rapid, clipped to the axes' and the control's limits) and path
-    acceleration the axes allow along each move, shapes (M,)."""
-    u = np.abs(moves.directions)
-    with np.errstate(divide="ignore"):
-        v_axes = np.min(np.asarray(machine.axis_max_velocity_mm_s) / u, axis=1)
-        a_axes = np.min(np.asarray(machine.axis_max_acceleration_mm_s2) / u, axis=1)
-    rapid = moves.kind == MotionKind.RAPID
-    feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
-    feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
-    return feed, a_axes
-
-
 def features(moves: Toolpath, machine: MachineProfile) -> np.ndarray:
     r"""Features of each move, shape (M, 6), columns :data:`FEATURES`.
 
@@ -165,7 +152,7 @@ def features(moves: Toolpath, machine: MachineProfile) -> np.ndarray:
     acceleration :math:`a_k` the axes allow along the move. The tool starts and ends at rest
     (corner angle :math:`\pi`).
     """
-    feed, acc = _move_limits(moves, machine)
+    feed, acc = move_limits(moves, machine)
     n = len(moves)
     theta = np.append(moves.corner_angles_rad, np.pi)
     if n:
