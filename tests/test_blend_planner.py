@@ -14,7 +14,9 @@ from nctwin.estimate.blend_planner import (
     OPTIMIZATION_DEPTH,
     STOP_TURN_RAD,
     blend_plane_acc,
-    depth_limits,
+    move_limits,
+    optimised_end_speeds,
+    parabolic_junctions,
 )
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
@@ -113,15 +115,35 @@ def test_an_item_runs_at_most_its_length_per_1_02_periods():
 
 
 def test_look_ahead_reaches_fifty_items():
-    # equal items: the end of each may be no faster than it can brake over the next 50 items at
-    # a and the 51st, still parabolic, at a / 2: v^2 = 2 a L (50 + 1/4)
-    length, acc = np.full(120, 0.2), np.full(120, A)
-    v = depth_limits(length, acc)
-    assert v[0] == pytest.approx(math.sqrt(2 * A * 0.2 * (OPTIMIZATION_DEPTH + 0.25)))
-    assert np.isinf(v[-OPTIMIZATION_DEPTH - 1 :]).all()
+    # equal collinear items, each queued move walks back through 50 of them from its own
+    # triangle speed at a / 2: the end of each is v^2 = 2 a L (50 + 1/4)
+    n, length = 120, 0.2
+    queued = np.arange(n - 1)  # the last item before each newly queued move
+    end = optimised_end_speeds(
+        np.full(n, length),
+        np.full(n, A),
+        np.full(n, 200.0),
+        np.arange(n) < n - 1,
+        queued,
+        np.full(n - 1, length),
+        np.full(n - 1, A / 2),
+        np.full(n - 1, 200.0),
+    )
+    assert end[0] == pytest.approx(math.sqrt(2 * A * length * (OPTIMIZATION_DEPTH + 0.25)))
     # 300 x 0.2 mm at 200 mm/s cruise at 141.8 mm/s (LinuxCNC: 0.583 s, 142 mm/s)
     moves = "".join(f"X{0.2 * k:.1f}\n" for k in range(1, 301))
     assert time_s(f"G21 G90 G64\nG1 F12000\n{moves}") == pytest.approx(0.583, abs=0.002)
+
+
+def test_the_lazy_look_ahead_dips_before_a_long_line():
+    # 39 moves of 0.4 mm on a quarter circle of 20 mm at 92 mm/s, then a 40 mm line: the walk
+    # back from the line stops after 5 items at their peak, and the arcs before them keep the
+    # end speeds of earlier walks, sqrt(12.5 (a / 2) L) = 50 mm/s (LinuxCNC: 1.497 s)
+    n = round(20 * math.pi / 2 / 0.4)
+    phi = np.arange(1, n + 1) * math.pi / 2 / n
+    corner = "".join(f"X{50 + 20 * math.sin(p):.4f} Y{20 - 20 * math.cos(p):.4f}\n" for p in phi)
+    program = f"G21 G90 G64 P0.3 Q0\nG1 X50 F5520\n{corner}Y60\n"
+    assert time_s(program) == pytest.approx(1.497, abs=0.002)
 
 
 def test_blend_arcs_take_the_acceleration_of_their_plane():
@@ -167,3 +189,20 @@ def test_naive_cam_merging_before_planning():
     merged = "G21 G90 G64 P0.01 Q0\nG1 F6000\nX5.05 Y0.004\nX10 Y0\n"
     assert time_s("G21 G90 G64 P0.01\nG1 F6000\n" + wiggle) == pytest.approx(time_s(merged))
     assert time_s(merged) < 0.5 * time_s("G21 G90 G64 P0.01 Q0\nG1 F6000\n" + wiggle)
+
+
+def test_an_arc_entered_from_outside_its_plane_gets_a_parabolic_blend():
+    # a line along Y into an arc in the XZ plane: no blend arc fits (the line is not in the
+    # arc's plane), LinuxCNC blends parabolically and halves both moves' acceleration; on the
+    # arc (Z: 500 mm/s^2) the speed stays within sqrt(0.866 (a / 2) r) and its tangential
+    # acceleration is (a / 2) / 2 (LinuxCNC's trace: 125 mm/s^2)
+    program = "G21 G90 G64 P0.1\nG0 X50 Y40 Z0\nG1 Y50 F6000\nG18 G2 X55 Z5 I5 K0\nG1 X45\n"
+    tp = parse(program, start_mm=(0, 0, 0))
+    moves = tp.take(np.arange(1, 4))
+    tol = moves.effective_tolerance_mm(MACHINE.blend_tol_mm)
+    np.testing.assert_array_equal(parabolic_junctions(moves, tol), [True, False])
+    feed, acc = move_limits(moves, MACHINE, np.array([0.5, 0.5, 1.0]))
+    assert feed[1] == pytest.approx(math.sqrt(NORMAL_ACC_RATIO * 250 * 5))
+    assert acc[1] == pytest.approx(125.0)
+    # LinuxCNC: 1.806 s (the parabolic blend is modelled as one junction speed)
+    assert time_s(program) == pytest.approx(1.806, rel=0.01)

@@ -7,6 +7,7 @@ has no jerk limit, so a straight line from rest to rest with a trapezoidal feed 
 """
 
 import glob
+import math
 import tempfile
 from pathlib import Path
 
@@ -154,8 +155,9 @@ def test_exact_stop_at_corner():
 #: must match: collinear lines at the full acceleration into a last move at a / 2, a blend arc
 #: with the full acceleration on the line before it, a chain of short blended lines, moves
 #: that turn back within 0.002 rad and stop, 300 moves of 0.2 mm held back by the look-ahead's
-#: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), and a rapid followed
-#: by a feed move (no blend between them).
+#: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), a rapid followed
+#: by a feed move (no blend between them), and a corner of short moves before a long line (the
+#: lazy look-ahead's dip).
 PLANNER_PROGRAMS = {
     "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
@@ -168,6 +170,12 @@ PLANNER_PROGRAMS = {
     + "".join(f"X{k / 2**0.5:.6f} Z{-(k % 2) / 2**0.5:.6f}\n" for k in range(1, 21))
     + "M2\n",
     "rapid_feed": "G21 G90 G64\nG0 X10\nG1 X20 F6000\nM2\n",
+    "lazy_corner": "G21 G90 G64 P0.3 Q0\nG1 X50 F5520\n"
+    + "".join(
+        f"X{50 + 20 * math.sin(p):.4f} Y{20 - 20 * math.cos(p):.4f}\n"
+        for p in np.arange(1, 80) * math.pi / 158
+    )
+    + "Y60\nM2\n",
 }
 
 

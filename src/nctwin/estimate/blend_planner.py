@@ -38,7 +38,12 @@ tangent :math:`u_1`, the second starting along :math:`u_2`:
   rad is blended (its source's own arc limit is 0.001 rad; what rejects the others is not
   modelled);
 * a line's remainder between two arcs that the next arc would pass in under
-  :data:`GAP_CYCLES` servo periods becomes part of that arc (``blendCheckConsume``).
+  :data:`GAP_CYCLES` servo periods becomes part of that arc (``blendCheckConsume``);
+* a junction with a programmed arc whose other move does not lie in the arc's plane gets no
+  blend arc but a parabolic blend (:func:`parabolic_junctions`): both moves run at half their
+  acceleration (on the arc: a speed limit :math:`1/\sqrt 2` lower and a tangential
+  acceleration of :math:`a/4`), and the junction is passed at the speed of
+  :func:`parabolic_blend_speeds`.
 
 **Items.** Along a line the tangential acceleration is the full :math:`a` the axes allow
 (:math:`\min_i a_{i,\max} / |u_i|`), through straight-on junctions too (LinuxCNC halves it only
@@ -47,10 +52,11 @@ condition it was queued with while blending is on: the move that ends the progra
 a dwell. That move accelerates and brakes at :math:`a/2`, and it is entered at most at its
 triangle speed :math:`\sqrt{a L / 2}`. Every item runs at most at its length over
 :data:`MIN_SEGMENT_CYCLES` servo periods (``tpComputeOptimalVelocity``), and the end of each is
-no faster than the look-ahead's depth allows (:func:`depth_limits`, ``tpRunOptimization``:
-:data:`OPTIMIZATION_DEPTH` items). Look-ahead: :math:`v_{j+1} \le \sqrt{v_j^2 + 2 a_k L_k}`
-forward and backward over the items. Item time: the trapezoid (or triangle) from :math:`v_j` to
-:math:`v_{j+1}` under the feed.
+no faster than LinuxCNC's look-ahead leaves it: it walks back from each newly queued move
+through at most :data:`OPTIMIZATION_DEPTH` items and, being lazy, stops after
+:data:`OPTIMIZATION_CUTOFF` items at their peak (:func:`optimised_end_speeds`, replayed move by
+move). Then :math:`v_{j+1} \le \sqrt{v_j^2 + 2 a_k L_k}` forward and backward over the items.
+Item time: the trapezoid (or triangle) from :math:`v_j` to :math:`v_{j+1}` under the feed.
 
 Measured on LinuxCNC (``linuxcnc_sim``, recorded live; model in brackets): one 60 mm line at
 50 mm/s in the default ``G64``: 1.301 s (1.300); a 90° corner of two 100 mm lines at 50 mm/s,
@@ -62,24 +68,28 @@ plain ``G64``: 300 x 1 mm 1.740 s (1.739), 10 x 5 mm 0.528 s (0.526), 3 x 20 mm 
 (0.615), 300 x 0.2 mm 0.583 s (0.582, held at 142 mm/s by the depth), 300 x 0.05 mm 0.364 s
 (0.364, held at 49 mm/s by the item length); zigzags of 45° moves, 20 x 5 mm in XY at
 ``G64 P0.5``: 2.237 s (2.237), 20 x 1 mm in XZ: 1.109 s (1.108); a rapid then a feed move:
-0.483 s (0.483); a G2 quarter circle of 10 mm radius under ``G61``: 0.355 s (0.355). Naive-CAM
+0.483 s (0.483); a G2 quarter circle of 10 mm radius under ``G61``: 0.355 s (0.355); 79 moves
+of 0.4 mm round a 20 mm corner at 92 mm/s, ``G64 P0.3``, then a 40 mm line: 1.497 s (1.496, the
+lazy look-ahead's dip to 50 mm/s); a line along Y into a G18 arc: 1.806 s (1.799). Naive-CAM
 merging: 300 moves of 0.01-0.1 mm with 2° turns under ``G64 P0.01`` 0.407 s (0.412); the
 public programs Cereal, Pasta and wheels, whose lines LinuxCNC reports are exactly those of the
 merged moves. The model misses two collinear lines (1.301 s, model 1.275: LinuxCNC runs the
 first at :math:`a/2` too) and 200 moves wiggling 0.004 mm about a line under ``G64 P0.01``,
 merged into two lines (0.254 s, model 0.273). The live tests of :mod:`nctwin.kernel.linuxcnc`
-check seven of these programs.
+check eight of these programs.
 
-Not modelled: the parabolic blends LinuxCNC falls back to where no arc fits, its own blends
-between a line and an arc or two arcs (here the line-line formula on the tangents), and helical
-arcs' effective radius.
+Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits,
+the size limits of its blends between a line and an arc or two arcs (here the line-line formula
+on the tangents), the "kink" of nearly tangent junctions, and helical arcs' effective radius.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
+from numba import njit
 
 from ..machine import MachineProfile
 from ..naivecam import merge_naive_cam
@@ -107,12 +117,17 @@ STOP_TURN_RAD = 0.02
 MIN_SEGMENT_CYCLES = 1.02
 #: Items the look-ahead walks back from the newest one (``ARC_BLEND_OPTIMIZATION_DEPTH``).
 OPTIMIZATION_DEPTH = 50
+#: The lazy look-ahead stops after passing more items at their peak than this
+#: (``TP_OPTIMIZATION_CUTOFF``).
+OPTIMIZATION_CUTOFF = 4
 #: A line remainder shorter than this many periods at the next arc's speed joins the arc
 #: (``ARC_BLEND_GAP_CYCLES``).
 GAP_CYCLES = 4
 
 
-def move_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, np.ndarray]:
+def move_limits(
+    moves: Toolpath, machine: MachineProfile, acc_scale: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     r"""Feed and tangential acceleration of each move as LinuxCNC plans it, shapes (M,).
 
     Lines and rapids: the feed (the rapid feed for rapids) within the control's maximum and
@@ -129,6 +144,9 @@ def move_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, n
     moves : Toolpath
         M moves of non-zero length (no dwells).
     machine : MachineProfile
+    acc_scale : ndarray, shape (M,), optional
+        Share of the acceleration each move may use (LinuxCNC halves it on both moves of a
+        parabolic blend, ``tcGetOverallMaxAccel``); 1 by default.
     """
     vmax = np.asarray(machine.axis_max_velocity_mm_s)
     amax = np.asarray(machine.axis_max_acceleration_mm_s2)
@@ -146,6 +164,8 @@ def move_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, n
     with np.errstate(divide="ignore"):
         v_axes = np.min(vmax / share, axis=1)
         acc = np.min(amax / share, axis=1)
+    if acc_scale is not None:
+        acc = acc * acc_scale
     rapid = moves.kind == MotionKind.RAPID
     feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
     feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
@@ -241,6 +261,66 @@ def junction_blends(
     return v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), acc
 
 
+def parabolic_junctions(moves: Toolpath, tol_mm: np.ndarray) -> np.ndarray:
+    """Junctions of M moves that LinuxCNC joins with a parabolic blend, shape (M - 1,).
+
+    A junction with a circular move gets a blend arc only if the other move lies in the arc's
+    plane (two arcs: parallel planes); otherwise ``tpCreateLineArcBlend`` (``ArcLine``,
+    ``ArcArc``) fails and ``tpChooseBestBlend`` falls back to a parabolic blend. Straight-on
+    junctions, stops (a tolerance of 0, a near-reversal) and line-line junctions are not
+    parabolic.
+    """
+    m = len(moves)
+    arc = moves.is_arc
+    normal = np.zeros((m, 3))
+    normal[np.arange(m), moves._plane_axes[:, 2]] = 1.0  # of the arc's plane
+    u1, u2 = moves.end_tangents[:-1], moves.start_tangents[1:]
+    b = np.cross(u1, u2)
+    size = np.linalg.norm(b, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        b = b / size[:, None]
+
+    def parallel(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return np.abs(np.abs(np.einsum("ij,ij->i", x, y)) - 1.0) < 1e-6
+
+    in_plane = (parallel(b, normal[:-1]) | ~arc[:-1]) & (parallel(b, normal[1:]) | ~arc[1:])
+    in_plane &= ~(arc[:-1] & arc[1:]) | parallel(normal[:-1], normal[1:])
+    dot = np.clip(np.einsum("ij,ij->i", u1, u2), -1.0, 1.0)
+    straight = dot >= 1.0 - 1e-12
+    reversal = np.arccos(-dot) < STOP_TURN_RAD  # stops
+    return (arc[:-1] | arc[1:]) & (tol_mm[1:] > 0) & ~straight & ~reversal & ~in_plane
+
+
+def parabolic_blend_speeds(
+    length_mm: np.ndarray,
+    feed_mm_s: np.ndarray,
+    acc_mm_s2: np.ndarray,
+    end_tangents: np.ndarray,
+    start_tangents: np.ndarray,
+    tol_mm: np.ndarray,
+) -> np.ndarray:
+    r"""Speed at the junctions of M moves if they were joined by parabolic blends, (M - 1,).
+
+    ``tpComputeBlendVelocity`` with the halved accelerations :math:`a_1, a_2`: each move's
+    reachable speed :math:`v_{r,i} = \min(\sqrt{a_i L_i}, F_i)`, the blend time
+    :math:`t_b = \min(L_1/v_{r,1}, L_2/v_{r,2}, \max(v_{r,1}/a_1, v_{r,2}/a_2))`, and the
+    speed :math:`v_i = \min(v_{r,i}, a_i t_b, 2\sqrt{a_1 T / \cos\theta})`. The move before
+    stops over :math:`v_1/a_1` while the next speeds up (``tpUpdateBlend``), at most to
+    :math:`v_2`: the junction is passed as if at :math:`\min(v_1, v_2, a_2 v_1 / a_1)`.
+    """
+    l1, l2, a1, a2 = length_mm[:-1], length_mm[1:], acc_mm_s2[:-1], acc_mm_s2[1:]
+    vr1 = np.minimum(np.sqrt(a1 * l1), feed_mm_s[:-1])
+    vr2 = np.minimum(np.sqrt(a2 * l2), feed_mm_s[1:])
+    t_blend = np.minimum(np.minimum(l1 / vr1, l2 / vr2), np.maximum(vr1 / a1, vr2 / a2))
+    dot = np.clip(np.einsum("ij,ij->i", end_tangents[:-1], start_tangents[1:]), -1.0, 1.0)
+    cos_t = np.cos(np.arccos(-dot) / 2.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v_tol = np.where(cos_t > 1e-3, 2.0 * np.sqrt(a1 * tol_mm[1:] / cos_t), np.inf)
+    v1 = np.minimum(np.minimum(vr1, t_blend * a1), v_tol)
+    v2 = np.minimum(np.minimum(vr2, t_blend * a2), v_tol)
+    return np.minimum(v1, np.minimum(v2, a2 * v1 / a1))
+
+
 def segment_times(
     length_mm: np.ndarray, feed_mm_s: np.ndarray, acc_mm_s2: np.ndarray, v_mm_s: np.ndarray
 ) -> np.ndarray:
@@ -272,29 +352,91 @@ def segment_times(
     return np.where(length_mm > 0, t, 0.0)
 
 
-def depth_limits(length_mm: np.ndarray, acc_mm_s2: np.ndarray) -> np.ndarray:
-    r"""Speed limit at the end of each of S queue items from the look-ahead's depth.
+@njit(cache=True)
+def _optimise(q_len, q_acc, q_max, blended, last_item, new_len, new_acc, new_max, depth, cutoff):
+    """Compiled body of :func:`optimised_end_speeds` (same arguments)."""  # pragma: no cover
+    end = np.zeros(len(q_len))
+    at_max = np.zeros(len(q_len), np.bool_)
+    for s in range(len(last_item)):
+        last = last_item[s]
+        if last < 0:
+            continue
+        peaks = 0
+        non_tangent = not blended[last]
+        if not non_tangent:  # the newest move, still parabolic: its triangle speed
+            end[last] = min(q_max[last], math.sqrt(new_acc[s] * new_len[s]), new_max[s])
+        for x in range(depth):
+            k = last - x
+            if k < 1:
+                break
+            if not blended[k - 1]:
+                if non_tangent:
+                    break
+                non_tangent = True
+                continue
+            v = math.sqrt(end[k] * end[k] + 2.0 * q_acc[k] * q_len[k])
+            v_max = min(q_max[k], q_max[k - 1])
+            if v >= v_max:
+                v = v_max
+                at_max[k - 1] = True
+            end[k - 1] = v
+            if at_max[k]:
+                peaks += 1
+                if peaks > cutoff:
+                    break
+    return end
 
-    LinuxCNC's optimiser (``tpRunOptimization``) walks back :data:`OPTIMIZATION_DEPTH` items
-    from the newest one, which may end no faster than it can stop at :math:`a/2` (its
-    parabolic end): the end of item :math:`k` is last raised when item :math:`k + D + 1` is
-    queued, to :math:`v_k^2 = \sum_{j=k+1}^{k+D} 2 a_j L_j + a_{k+D+1} L_{k+D+1} / 2`. ``inf``
-    where that window reaches the end of the program (the stop there is the look-ahead's).
+
+def optimised_end_speeds(
+    length_mm: np.ndarray,
+    acc_mm_s2: np.ndarray,
+    max_mm_s: np.ndarray,
+    blended: np.ndarray,
+    last_item: np.ndarray,
+    new_length_mm: np.ndarray,
+    new_acc_mm_s2: np.ndarray,
+    new_max_mm_s: np.ndarray,
+) -> np.ndarray:
+    r"""End speeds of S queue items as LinuxCNC's look-ahead leaves them (``tpRunOptimization``,
+    ``tpComputeOptimalVelocity``), replayed once per queued move.
+
+    Each time a move is queued, the optimiser starts from the newest move, still parabolic
+    (its triangle speed :math:`\sqrt{a_t L}`), and walks back through at most
+    :data:`OPTIMIZATION_DEPTH` items, raising each end speed to
+    :math:`\sqrt{v_{end}^2 + 2 a L}` of the item after it, within the planning limit of both
+    items (where it reaches that limit the item is marked at its peak). It stops at the second
+    junction that is not blended, and, being lazy (``TP_OPTIMIZATION_LAZY``), once it has
+    passed more than :data:`OPTIMIZATION_CUTOFF` items at their peak. Ends the walks never reach
+    keep the speed of the last walk that did: on a chain of short items the speed dips where
+    a walk from a long move ran out.
 
     Parameters
     ----------
-    length_mm, acc_mm_s2 : ndarray, shape (S,)
+    length_mm, acc_mm_s2, max_mm_s : ndarray, shape (S,)
+        Length, tangential acceleration and planning speed limit of each item.
+    blended : ndarray of bool, shape (S,)
+        The item ends in a junction the tool passes without stopping.
+    last_item : ndarray of int64, shape (Q,)
+        For each queued move after the first, the last item queued before it (-1: none).
+    new_length_mm, new_acc_mm_s2, new_max_mm_s : ndarray, shape (Q,)
+        The newest move when it is queued: its length (trimmed at the start only), its
+        acceleration at the parabolic end, and its speed limit.
 
     Returns
     -------
     ndarray, shape (S,)
     """
-    n, depth = len(length_mm), OPTIMIZATION_DEPTH
-    c = np.concatenate([[0.0], np.cumsum(2.0 * acc_mm_s2 * length_mm)])
-    k = np.arange(n - depth - 1)
-    newest = k + depth + 1
-    v2 = c[newest] - c[k + 1] + 0.5 * acc_mm_s2[newest] * length_mm[newest]
-    return np.concatenate([np.sqrt(v2), np.full(n - len(k), np.inf)])
+    args = [np.ascontiguousarray(a, dtype=np.float64) for a in (length_mm, acc_mm_s2, max_mm_s)]
+    new = [np.ascontiguousarray(a, dtype=np.float64) for a in (new_length_mm, new_acc_mm_s2)]
+    return _optimise(
+        *args,
+        np.ascontiguousarray(blended, dtype=np.bool_),
+        np.ascontiguousarray(last_item, dtype=np.int64),
+        *new,
+        np.ascontiguousarray(new_max_mm_s, dtype=np.float64),
+        OPTIMIZATION_DEPTH,
+        OPTIMIZATION_CUTOFF,
+    )
 
 
 def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
@@ -335,8 +477,22 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     v, d, arc, arc_acc = junction_blends(
         length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc
     )
+    # junctions with an arc that get no blend arc: a parabolic blend, both moves at half their
+    # acceleration (halved once, with a parabolic end too)
+    para = parabolic_junctions(moves, tol)
+    halved = np.zeros(len(moves), bool)
+    halved[:-1] |= para
+    halved[1:] |= para
+    if para.any():
+        feed, acc = move_limits(moves, machine, np.where(halved, TANGENTIAL_ACC_RATIO, 1.0))
+        speed = parabolic_blend_speeds(
+            length, feed, acc, moves.end_tangents, moves.start_tangents, tol
+        )
+        v = np.where(para, speed, v)
+        d = np.where(para, 0.0, d)
+        arc = np.where(para, 0.0, arc)
     # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed
-    a_line = acc * np.where(parabolic_end, TANGENTIAL_ACC_RATIO, 1.0)
+    a_line = acc * np.where(parabolic_end & ~halved, TANGENTIAL_ACC_RATIO, 1.0)
     v = np.where(parabolic_end[1:], np.minimum(v, np.sqrt(a_line * length)[1:]), v)
     # the queue: line 0, arc 0, line 1, ..., line M-1; the arcs of unblended junctions empty
     m = len(moves)
@@ -356,14 +512,37 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     item_feed[0::2] = feed
     item_feed[1::2] = v
     end_limit = np.append(np.repeat(v, 2), 0.0)  # at the end of each item
-    # the items LinuxCNC queues: the non-empty ones; an empty one passes its limit on
+    # the items LinuxCNC queues: the non-empty ones; an empty one sits at the end of the kept
+    # item before it, where its limit applies
     keep = np.flatnonzero(item_len > 0)
-    group = np.searchsorted(keep, np.arange(2 * m - 1))  # item each empty one ends into
+    at = np.searchsorted(keep, np.arange(2 * m - 1), side="right") - 1
     limit = np.full(len(keep), np.inf)
-    np.minimum.at(limit, np.minimum(group, len(keep) - 1), end_limit)
+    np.minimum.at(limit, at[at >= 0], end_limit[at >= 0])
     q_len, q_acc = item_len[keep], item_acc[keep]
-    q_feed = np.minimum(item_feed[keep], q_len / (MIN_SEGMENT_CYCLES * machine.period_s))
-    limit = np.minimum(limit, depth_limits(q_len, q_acc))
+    cap = q_len / (MIN_SEGMENT_CYCLES * machine.period_s)
+    q_feed = np.minimum(item_feed[keep], cap)
+    # the look-ahead plans with the speed limits of the machine, not the programmed feed
+    item_max = np.empty(2 * m - 1)
+    unfed = dataclasses.replace(moves, feed_mm_s=np.full(m, np.inf))
+    item_max[0::2] = move_limits(unfed, machine)[0]
+    item_max[1::2] = v
+    blended = limit > 0
+    blended[-1] = False
+    queued = np.arange(1, m)  # move s is queued after the arc that joins it to move s - 1
+    new_len = length[1:] - d
+    if m > 1:
+        new_len[-1] = length[-1]  # the last move: its measured entry, sqrt(a L / 2)
+    end = optimised_end_speeds(
+        q_len,
+        q_acc,
+        np.minimum(item_max[keep], cap),
+        blended,
+        np.searchsorted(keep, 2 * queued - 1, side="right") - 1,
+        new_len,
+        TANGENTIAL_ACC_RATIO * acc[1:],
+        np.minimum(feed[1:], length[1:] / (MIN_SEGMENT_CYCLES * machine.period_s)),
+    )
+    limit = np.minimum(limit, np.where(blended, end, 0.0))
     limit = np.minimum(limit[:-1], np.minimum(q_feed[:-1], q_feed[1:]))
     t = np.zeros(2 * m - 1)
     t[keep] = segment_times(q_len, q_feed, q_acc, limit)
