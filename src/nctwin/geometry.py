@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._geometry_loops import path_points
 from .toolpath import PLANE_AXES, Toolpath
 
 __all__ = ["PathGeometry"]
@@ -53,7 +54,35 @@ class PathGeometry:
         return np.clip(k, 0, max(len(self.lengths_mm) - 1, 0))
 
     def points(self, s_mm: np.ndarray) -> np.ndarray:
-        """Positions at arc lengths ``s_mm`` (clipped to the path), shape (len(s_mm), 3)."""
+        """Positions at arc lengths ``s_mm`` (clipped to the path), shape (len(s_mm), 3).
+
+        A compiled loop (:func:`nctwin._geometry_loops.path_points`), bit for bit the numpy
+        of :meth:`points_numpy`."""
+        tp = self.toolpath
+        s = np.ascontiguousarray(s_mm, dtype=np.float64)
+        out = np.zeros((len(s), 3))
+        if len(tp) == 0:
+            return out
+        path_points(
+            s,
+            self.s_start_mm,
+            self.lengths_mm,
+            tp.start_mm,
+            self._chord,
+            self._arc,
+            self._ax,
+            self._theta0,
+            self._sweep,
+            self._r0,
+            self._r1,
+            tp.center_mm,
+            self._dn,
+            out,
+        )
+        return out
+
+    def points_numpy(self, s_mm: np.ndarray) -> np.ndarray:
+        """:meth:`points` in numpy: the definition the compiled loop reproduces."""
         tp = self.toolpath
         if len(tp) == 0:
             return np.zeros((len(s_mm), 3))
@@ -64,7 +93,7 @@ class PathGeometry:
             s - self.s_start_mm.take(k), length, out=np.zeros_like(s), where=length > 0
         )
         frac = np.clip(frac, 0.0, 1.0)
-        out = np.take(tp.start_mm, k, axis=0)  # take: faster than fancy indexing
+        out = np.take(tp.start_mm, k, axis=0)
         out += frac[:, None] * np.take(self._chord, k, axis=0)
         arc = self._arc[k]
         if arc.any():
