@@ -13,6 +13,7 @@ from nctwin.features import BlockTargets
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
 from nctwin.paths import results_dir
+from nctwin.recordings import RecordedProgram
 
 MACHINE = load_machine("linuxcnc_sim")  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
 
@@ -113,3 +114,31 @@ def test_profile_carries_the_chapters_fit_and_best_method():
         assert getattr(MACHINE, field) == pytest.approx(best[field])
     summary = pd.read_csv(results / "summary.csv")
     assert MACHINE.default_method == rk.best_method(summary)
+
+
+def _recording(name: str, program: str, time_s: float, source: str = "nctwin") -> RecordedProgram:
+    targets = BlockTargets(
+        np.array([0, round(time_s / 0.001)]), np.array([60.0]), np.array([time_s])
+    )
+    return RecordedProgram(name, program, MACHINE.name, targets, np.zeros(1), 0, "", "", source)
+
+
+def test_planner_rows_on_recordings_by_hand():
+    # G61: 60/50 + 50/1000 = 1.25 s; plain G64, last move at a/2: 60/50 + 50/500 = 1.3 s
+    recs = {
+        "train_a": _recording("train_a", "G21 G90 G61\nG1 X60 F3000\n", 1.25),
+        "broad_b": _recording("broad_b", "G21 G90 G64\nG1 X60 F3000\n", 1.3 * 1.04),
+    }
+    rows = rk.planner_rows(recs, MACHINE)
+    assert list(rows.set) == ["train", "broad"]
+    assert list(rows.no_tolerance) == [False, True]
+    np.testing.assert_allclose(rows.predicted_s, [1.25, 1.3])
+    np.testing.assert_allclose(rows.err_pct, [0.0, 100 * (1 / 1.04 - 1)])
+    summary = rk.method_summary(rows, by=["no_tolerance"])
+    assert list(summary.underestimates) == [0, 1]
+
+
+def test_planner_rows_need_the_program_text():
+    rec = _recording("public_x", "", 1.0, source="public/x.ngc")
+    with pytest.raises(ValueError, match=r"source = 'public/x\.ngc'"):
+        rk.planner_rows({"public_x": rec}, MACHINE)

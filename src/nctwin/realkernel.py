@@ -47,6 +47,7 @@ from joblib import Parallel, delayed
 from .estimate import Estimate, block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner, move_limits
 from .features import BlockTargets, sun2022_features
+from .gcode import parse
 from .geometry import PathGeometry
 from .machine import MachineProfile
 from .models import ModelConfig
@@ -79,6 +80,7 @@ __all__ = [
     "method_summary",
     "model_blocks",
     "move_data",
+    "planner_rows",
     "predict_axis_nn",
     "predict_bilstm",
     "recorded_move_data",
@@ -239,8 +241,6 @@ def move_data(
 
 def recorded_move_data(rec: RecordedProgram, machine: MachineProfile) -> MoveData:
     """:func:`move_data` of a shipped recording of one of nctwin's programs."""
-    from .gcode import parse
-
     return move_data(rec.name, parse(rec.program), machine, rec.targets)
 
 
@@ -475,9 +475,47 @@ def method_rows(
     return pd.DataFrame(rows, columns=list(METHOD_COLUMNS))
 
 
-def method_summary(rows: pd.DataFrame) -> pd.DataFrame:
-    """Median and worst absolute error (%) per set and method, and how often it underestimates."""
-    g = rows.assign(abs_err_pct=rows.err_pct.abs()).groupby(["set", "method"], sort=False)
+def planner_rows(recordings: dict[str, RecordedProgram], machine: MachineProfile) -> pd.DataFrame:
+    """The blend-arc planner alone on recordings of nctwin's own programs.
+
+    The planner learns nothing from recordings, so the training sets are held-out programs for
+    it: a check of its rules on programs that were not used to find them.
+
+    Parameters
+    ----------
+    recordings : dict
+        Name -> :class:`~nctwin.recordings.RecordedProgram` with its text (``source`` =
+        ``nctwin``); the set is the name's prefix (``train``, ``broad``, ``test``).
+
+    Returns
+    -------
+    DataFrame
+        Columns :data:`METHOD_COLUMNS` and ``no_tolerance``: whether the program blends
+        without a tolerance (a plain ``G64``) anywhere; ``err_pct`` is signed.
+    """
+    rows = []
+    for name, rec in recordings.items():
+        if rec.source != "nctwin":
+            raise ValueError(
+                f"recording {name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
+                "whose text is shipped)"
+            )
+        tp = parse(rec.program)
+        t = blend_planner(tp, machine).cycle_time_s
+        no_tol = bool(np.isinf(tp.effective_tolerance_mm(machine.blend_tol_mm)).any())
+        rows.append(
+            {"program": name, "set": name.split("_", 1)[0], "method": "planner",
+             "measured_s": rec.cycle_time_s, "predicted_s": t,
+             "err_pct": 100.0 * (t - rec.cycle_time_s) / rec.cycle_time_s,
+             "no_tolerance": no_tol}
+        )  # fmt: skip
+    return pd.DataFrame(rows, columns=[*METHOD_COLUMNS, "no_tolerance"])
+
+
+def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) -> pd.DataFrame:
+    """Median and worst absolute error (%) per group of ``rows`` (by default per set and
+    method), and how often it underestimates."""
+    g = rows.assign(abs_err_pct=rows.err_pct.abs()).groupby(list(by), sort=False)
     return g.agg(
         programs=("program", "size"),
         median_abs_err_pct=("abs_err_pct", "median"),
