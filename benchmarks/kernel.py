@@ -9,6 +9,8 @@ pocket: ``kernel_pocket5000_plan_s`` times the look-ahead (``fir.plan``) alone,
 ``kernel_sample_stage_samples_per_s`` divides the output samples by what the run takes beyond
 the plan (the speed command, sampling it, the filters and the axis-limit passes) and
 ``kernel_filter_samples_per_s`` times the O(n) filter stage alone (``FirFilter.apply``).
+``contour.ngc`` runs its 10,000 blocks in about 1,300 samples, so per-block work decides its
+time: ``kernel_contour_blocks_per_s`` gives its rate in blocks.
 """
 
 from __future__ import annotations
@@ -61,6 +63,7 @@ def main() -> None:
         n = len(fir.run(tp, machine))
         tc = cold_time_s(lambda tp: fir.run(tp, machine), tp)
         record("kernel_contour_samples_per_s", round(n / tc), "samples/s", ">= 1e7")
+        record("kernel_contour_blocks_per_s", round(len(tp) / tc), "blocks/s", "")
         total_samples += n
         total_time += tc
     else:
