@@ -39,17 +39,36 @@ def path_points(  # pragma: no cover - compiled
     second and normal axis of each block's plane; ``theta0_rad``, ``sweep_rad``, ``r0_mm``,
     ``r1_mm``, ``normal_mm`` (N,) the arcs' start angle, sweep, start and end radius and travel
     along the normal. Arc lengths are clipped to the path; a block is found as
-    ``searchsorted(s_start_mm, s, "right") - 1`` clipped to the blocks.
+    ``searchsorted(s_start_mm, s, "right") - 1`` clipped to the blocks, by galloping from the
+    block of the previous query.
     """
     n = len(lengths_mm)
     total = s_start_mm[n]
+    k = 0
     for q in range(len(s_mm)):
         s = s_mm[q]
         if s < 0.0:
             s = 0.0
         if s > total:
             s = total
-        lo, hi = 0, n + 1  # first index whose start exceeds s
+        # first index whose start exceeds s: galloping from the last query's, as queries come
+        # in runs near each other (the same index as a binary search over the whole path)
+        if s_start_mm[k] <= s:
+            lo, step = k + 1, 1
+            hi = lo
+            while hi <= n and s_start_mm[hi] <= s:
+                lo = hi + 1
+                hi = lo + step
+                step *= 2
+            hi = min(hi, n + 1)
+        else:
+            hi, step = k, 1
+            lo = hi
+            while lo > 0 and s_start_mm[lo - 1] > s:
+                hi = lo - 1
+                lo = hi - step
+                step *= 2
+            lo = max(lo, 0)
         while lo < hi:
             mid = (lo + hi) >> 1
             if s_start_mm[mid] <= s:
