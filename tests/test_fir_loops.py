@@ -72,3 +72,29 @@ def test_derivative_peaks_equal_numpy_differences(seed, n):
     jerk = np.diff(acc, axis=0) / PERIOD_S
     for order, d in enumerate([expected_vel[1:], acc, jerk]):
         np.testing.assert_array_equal(peak[order], np.abs(d).max(axis=0, initial=0.0))
+
+
+def _numpy_limit_ratios(vel, limits, over):
+    """The ratios with numpy's differences, as the kernel computed them before the loop."""
+    derivs = [vel[1:]]
+    for _ in range(2):
+        derivs.append(np.diff(derivs[-1], axis=0) / PERIOD_S)
+    ratio = np.zeros(len(vel))
+    for order, a in np.argwhere(over):
+        r = np.abs(derivs[order][:, a]) / limits[order, a]
+        np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
+    return ratio
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300), mask=st.integers(0, 511))
+def test_limit_ratios_equal_numpy_differences(seed, n, mask):
+    rng = np.random.default_rng(seed)
+    pos = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    vel = np.empty_like(pos)
+    _fir_loops.derivative_peaks(pos, PERIOD_S, vel)
+    limits = rng.uniform(0.5, 2.0, (3, 3)) * np.array([[1e3], [1e6], [1e9]])
+    over = (mask >> np.arange(9)).reshape(3, 3) % 2 == 1
+    ratio = np.empty(n)
+    _fir_loops.limit_ratios(vel, PERIOD_S, limits, over, ratio)
+    np.testing.assert_array_equal(ratio, _numpy_limit_ratios(vel, limits, over))

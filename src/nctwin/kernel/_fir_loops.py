@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["box_cascade", "derivative_peaks", "sample_command"]
+__all__ = ["box_cascade", "derivative_peaks", "limit_ratios", "sample_command"]
 
 
 @njit(cache=True)
@@ -95,25 +95,57 @@ def derivative_peaks(pos, period_s, vel):  # pragma: no cover - compiled
 
     ``pos`` (n, 3); writes ``vel`` (n, 3), backward differences with ``vel[0] = 0``; returns
     (3, 3): row = derivative order (velocity from sample 1 on, acceleration, jerk as
-    successive backward differences over the period), column = axis.
+    successive backward differences over the period), column = axis. One pass per axis, the
+    previous velocity and acceleration carried along.
     """
     n = pos.shape[0]
     peak = np.zeros((3, 3))
     for a in range(3):
         vel[0, a] = 0.0
-    for i in range(1, n):
-        for a in range(3):
-            vel[i, a] = (pos[i, a] - pos[i - 1, a]) / period_s
-            v = abs(vel[i, a])
-            if v > peak[0, a]:
-                peak[0, a] = v
+        v_prev = 0.0
+        acc_prev = 0.0
+        top_v = 0.0
+        top_acc = 0.0
+        top_jerk = 0.0
+        for i in range(1, n):
+            v = (pos[i, a] - pos[i - 1, a]) / period_s
+            vel[i, a] = v
+            top_v = max(top_v, abs(v))
+            if i >= 2:
+                acc = (v - v_prev) / period_s
+                top_acc = max(top_acc, abs(acc))
+                if i >= 3:
+                    top_jerk = max(top_jerk, abs((acc - acc_prev) / period_s))
+                acc_prev = acc
+            v_prev = v
+        peak[0, a] = top_v
+        peak[1, a] = top_acc
+        peak[2, a] = top_jerk
+    return peak
+
+
+@njit(cache=True)
+def limit_ratios(vel, period_s, limits, over, ratio):  # pragma: no cover - compiled
+    """Per sample, the largest ratio of an axis derivative to its limit, over the (order, axis)
+    pairs that ``over`` (3, 3) marks.
+
+    ``vel`` (n, 3) as :func:`derivative_peaks` writes it; ``limits`` (3, 3) as its peaks (row =
+    order, column = axis); writes ``ratio`` (n,): the derivative of order ``k`` (0 velocity, 1
+    acceleration, 2 jerk) counts at sample ``i`` from ``i = k + 1`` on, 0 where none counts.
+    The same differences as :func:`derivative_peaks` (and ``np.diff`` over the period).
+    """
+    n = vel.shape[0]
+    for i in range(n):
+        ratio[i] = 0.0
+    for a in range(3):
+        acc_prev = 0.0
+        for i in range(1, n):
+            if over[0, a]:
+                ratio[i] = max(ratio[i], abs(vel[i, a]) / limits[0, a])
             if i >= 2:
                 acc = (vel[i, a] - vel[i - 1, a]) / period_s
-                if abs(acc) > peak[1, a]:
-                    peak[1, a] = abs(acc)
-                if i >= 3:
-                    acc0 = (vel[i - 1, a] - vel[i - 2, a]) / period_s
-                    jerk = (acc - acc0) / period_s
-                    if abs(jerk) > peak[2, a]:
-                        peak[2, a] = abs(jerk)
-    return peak
+                if over[1, a]:
+                    ratio[i] = max(ratio[i], abs(acc) / limits[1, a])
+                if i >= 3 and over[2, a]:
+                    ratio[i] = max(ratio[i], abs((acc - acc_prev) / period_s) / limits[2, a])
+                acc_prev = acc

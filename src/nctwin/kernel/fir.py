@@ -504,18 +504,11 @@ def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray):
     common case, checked first on the peaks of one compiled pass)."""
     vel = np.empty_like(pos)
     peak = _fir_loops.derivative_peaks(pos, ts, vel)
-    over = np.argwhere(peak > limits * (1.0 + LIMIT_RTOL))  # (order, axis) above the limit
-    if not len(over):
+    over = peak > limits * (1.0 + LIMIT_RTOL)  # (order, axis) above the limit
+    if not over.any():
         return vel, None
-    derivs = [vel[1:]]
-    for _ in range(2):
-        d = np.diff(derivs[-1], axis=0)
-        d /= ts
-        derivs.append(d)
-    ratio = np.zeros(len(vel))
-    for order, a in over:
-        r = np.abs(derivs[order][:, a]) / limits[order, a]
-        np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
+    ratio = np.empty(len(vel))
+    _fir_loops.limit_ratios(vel, ts, limits, over, ratio)
     return vel, ratio
 
 
