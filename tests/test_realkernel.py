@@ -131,11 +131,29 @@ def test_planner_rows_on_recordings_by_hand():
     }
     rows = rk.planner_rows(recs, MACHINE)
     assert list(rows.set) == ["train", "broad"]
-    assert list(rows.no_tolerance) == [False, True]
+    assert list(rows["mode"]) == ["G61", "G64"]
     np.testing.assert_allclose(rows.predicted_s, [1.25, 1.3])
     np.testing.assert_allclose(rows.err_pct, [0.0, 100 * (1 / 1.04 - 1)])
-    summary = rk.method_summary(rows, by=["no_tolerance"])
+    summary = rk.method_summary(rows, by=["mode"])
     assert list(summary.underestimates) == [0, 1]
+    gaps = rk.planner_block_gaps(recs["broad_b"], MACHINE, n=1)
+    assert gaps.block.tolist() == [0] and gaps.kind.tolist() == ["linear"]
+    assert gaps.planner_s.iloc[0] == pytest.approx(1.3)
+    with pytest.raises(ValueError, match="n = 0"):
+        rk.planner_block_gaps(recs["broad_b"], MACHINE, n=0)
+
+
+@pytest.mark.parametrize(
+    ("program", "mode"),
+    [
+        ("G1 X1 F600\n", "G64 P Q0"),  # the profile's tolerance, Q0
+        ("G64 P0.1\nG1 X1 F600\n", "G64 P Q>0"),  # Q = P
+        ("G64 P0.1 Q0\nG1 X1 F600\nG64\nG1 X2\nG61\nG1 X3\nG61.1\nG1 X4\n",
+         "G64 P Q0, G64, G61, G61.1"),
+    ],
+)  # fmt: skip
+def test_path_control_follows_linuxcnc(program, mode):
+    assert rk.path_control(parse("G21 G90\n" + program), MACHINE) == mode
 
 
 def test_planner_rows_need_the_program_text():

@@ -55,7 +55,7 @@ from .recordings import MACHINE as RECORDED_MACHINE
 from .recordings import RecordedProgram, load_recordings
 from .sun2022 import MIN_FEED_SHARE
 from .sun2022 import MODEL_CONFIG as AXIS_NN_CONFIG
-from .toolpath import MotionKind, Toolpath
+from .toolpath import MotionKind, PathMode, Toolpath
 from .train import TrainConfig, Trained, fit
 
 __all__ = [
@@ -67,6 +67,7 @@ __all__ = [
     "METHOD_COLUMNS",
     "TIME_TARGETS",
     "TOL_CAP_MM",
+    "TRAINING_SETS",
     "MoveData",
     "axis_nn_estimate",
     "axis_nn_move_times",
@@ -80,6 +81,8 @@ __all__ = [
     "method_summary",
     "model_blocks",
     "move_data",
+    "path_control",
+    "planner_block_gaps",
     "planner_rows",
     "predict_axis_nn",
     "predict_bilstm",
@@ -438,6 +441,9 @@ def analytic_times(tp: Toolpath, machine: MachineProfile, fir_fitted: MachinePro
 # ------------------------------------------------------------------------------------------------
 # Tables
 
+#: Sets of recordings the learned methods can learn from (:func:`training_data`).
+TRAINING_SETS = ("train", "broad", "cam")
+
 #: Columns of :func:`method_rows` (the chapter's ``methods.csv``).
 METHOD_COLUMNS = ("program", "set", "method", "measured_s", "predicted_s", "err_pct")
 
@@ -475,6 +481,27 @@ def method_rows(
     return pd.DataFrame(rows, columns=list(METHOD_COLUMNS))
 
 
+def path_control(tp: Toolpath, machine: MachineProfile) -> str:
+    """The path-control modes a program's moves run in, LinuxCNC's rules, as G-code.
+
+    ``G61`` (exact path), ``G61.1`` (exact stop), ``G64`` (no tolerance), ``G64 P Q0`` (a
+    tolerance, no naive-CAM merging) or ``G64 P Q>0`` (a tolerance, merging within Q; a
+    ``G64 P`` without Q sets Q = P); several are joined by ``", "`` in their order in the
+    program.
+    """
+    moving = tp.kind != MotionKind.DWELL
+    tol = tp.effective_tolerance_mm(machine.blend_tol_mm)[moving]
+    naive = tp.effective_naive_tol_mm()[moving]
+    mode = tp.path_mode[moving]
+    label = np.where(
+        mode == PathMode.EXACT_STOP, "G61.1",
+        np.where(mode == PathMode.EXACT_PATH, "G61",
+                 np.where(np.isinf(tol), "G64", np.where(naive > 0, "G64 P Q>0", "G64 P Q0"))),
+    )  # fmt: skip
+    _, first = np.unique(label, return_index=True)
+    return ", ".join(label[np.sort(first)])
+
+
 def planner_rows(recordings: dict[str, RecordedProgram], machine: MachineProfile) -> pd.DataFrame:
     """The blend-arc planner alone on recordings of nctwin's own programs.
 
@@ -485,31 +512,52 @@ def planner_rows(recordings: dict[str, RecordedProgram], machine: MachineProfile
     ----------
     recordings : dict
         Name -> :class:`~nctwin.recordings.RecordedProgram` with its text (``source`` =
-        ``nctwin``); the set is the name's prefix (``train``, ``broad``, ``test``).
+        ``nctwin``); the set is the name's prefix (``train``, ``broad``, ``cam``, ``test``).
 
     Returns
     -------
     DataFrame
-        Columns :data:`METHOD_COLUMNS` and ``no_tolerance``: whether the program blends
-        without a tolerance (a plain ``G64``) anywhere; ``err_pct`` is signed.
+        Columns :data:`METHOD_COLUMNS` and ``mode``, the program's :func:`path_control`;
+        ``err_pct`` is signed.
     """
     rows = []
     for name, rec in recordings.items():
-        if rec.source != "nctwin":
-            raise ValueError(
-                f"recording {name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
-                "whose text is shipped)"
-            )
-        tp = parse(rec.program)
+        tp = _own_program(name, rec)
         t = blend_planner(tp, machine).cycle_time_s
-        no_tol = bool(np.isinf(tp.effective_tolerance_mm(machine.blend_tol_mm)).any())
         rows.append(
             {"program": name, "set": name.split("_", 1)[0], "method": "planner",
              "measured_s": rec.cycle_time_s, "predicted_s": t,
              "err_pct": 100.0 * (t - rec.cycle_time_s) / rec.cycle_time_s,
-             "no_tolerance": no_tol}
+             "mode": path_control(tp, machine)}
         )  # fmt: skip
-    return pd.DataFrame(rows, columns=[*METHOD_COLUMNS, "no_tolerance"])
+    return pd.DataFrame(rows, columns=[*METHOD_COLUMNS, "mode"])
+
+
+def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3) -> pd.DataFrame:
+    """The ``n`` blocks of a recording of nctwin's own programs whose time the blend-arc planner
+    misses most: block, kind, length (mm), programmed feed (mm/s), recorded and planned time
+    (s), sorted by block."""
+    if not (isinstance(n, int) and n >= 1):
+        raise ValueError(f"n = {n!r} is out of range: allowed integers >= 1")
+    tp = _own_program(rec.name, rec)
+    planned = blend_planner(tp, machine).block_times_s
+    measured = rec.targets.time_s
+    worst = np.sort(np.argsort(-np.abs(planned - measured), kind="stable")[:n])
+    return pd.DataFrame(
+        {"block": worst, "kind": [MotionKind(k).name.lower() for k in tp.kind[worst]],
+         "length_mm": tp.lengths_mm[worst], "feed_mm_s": tp.feed_mm_s[worst],
+         "measured_s": measured[worst], "planner_s": planned[worst]}
+    )  # fmt: skip
+
+
+def _own_program(name: str, rec: RecordedProgram) -> Toolpath:
+    """The parsed text of a recording of one of nctwin's programs."""
+    if rec.source != "nctwin":
+        raise ValueError(
+            f"recording {name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
+            "whose text is shipped)"
+        )
+    return parse(rec.program)
 
 
 def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) -> pd.DataFrame:
@@ -541,14 +589,25 @@ def train_configs(seed: int = 0, scale: float = 1.0) -> tuple[TrainConfig, Train
     return bilstm, axis
 
 
-def training_data(machine: MachineProfile) -> list[MoveData]:
-    """The ``train_*`` and ``broad_*`` recordings of ``machine`` as :class:`MoveData`.
+def training_data(
+    machine: MachineProfile, sets: Sequence[str] = ("train", "broad")
+) -> list[MoveData]:
+    """The recordings of ``machine`` of the training ``sets`` as :class:`MoveData`.
+
+    ``sets`` picks among ``train`` (paper 1's programs), ``broad`` (the broad set) and ``cam``
+    (the CAM-style set, :mod:`nctwin.programs.camstyle`); the chapter's methods learn from the
+    first two.
 
     Raises
     ------
     ValueError
-        If ``machine`` is not the machine of the shipped recordings.
+        If ``machine`` is not the machine of the shipped recordings, or a set is unknown.
     """
+    unknown = set(sets) - set(TRAINING_SETS)
+    if unknown:
+        raise ValueError(
+            f"sets = {tuple(sets)!r} is not allowed: allowed {', '.join(TRAINING_SETS)}"
+        )
     if machine.name != RECORDED_MACHINE:
         raise ValueError(
             f"machine = {machine.name!r} has no recordings to learn from: allowed "
@@ -558,7 +617,7 @@ def training_data(machine: MachineProfile) -> list[MoveData]:
     return [
         recorded_move_data(rec, machine)
         for name, rec in recs.items()
-        if name.startswith(("train_", "broad_"))
+        if name.startswith(tuple(f"{s}_" for s in sets))
     ]
 
 

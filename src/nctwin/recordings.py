@@ -2,10 +2,11 @@
 
 LinuxCNC (:mod:`nctwin.kernel.linuxcnc`) is the measured machine. Its recordings of paper 1's
 training programs (:func:`nctwin.programs.training.training_specs`, F 65-100 mm/s,
-G64 P 0.05-0.5 mm) and test programs (toolpaths I and II, the pocket; F 75 and 92 mm/s,
-G64 P 0.3 and 0.4 mm) are shipped as a measurement, the way a paper's data set would be, so
-that chapters use them without LinuxCNC. ``make record`` re-records them from nothing (it needs
-``make linuxcnc``); :func:`load_recordings` reads them.
+G64 P 0.05-0.5 mm), of a broader set (:data:`BROAD`), of CAM-style programs
+(:func:`nctwin.programs.camstyle.cam_program`) and of the test programs (toolpaths I and II, the
+pocket; F 75 and 92 mm/s, G64 P 0.3 and 0.4 mm) are shipped as a measurement, the way a
+paper's data set would be, so that chapters use them without LinuxCNC. ``make record``
+re-records them from nothing (it needs ``make linuxcnc``); :func:`load_recordings` reads them.
 
 Public part programs written by others (``../shared/programs/``, GPL) are recorded the same way
 (:func:`record_public`) and shipped as measurements only, without their text: a chapter that
@@ -45,6 +46,7 @@ from .kernel.linuxcnc import LinuxCNCAborted
 from .machine import MachineProfile, load_machine
 from .motion import Motion
 from .paths import atomic_write_text, data_dir, public_programs_dir
+from .programs.camstyle import cam_program
 from .programs.pocket import pocket_program
 from .programs.training import broad_program, contour_program, training_specs
 
@@ -88,6 +90,10 @@ BROAD = dict(
     max_tilt_rad=math.pi / 3,
     max_time_s=60.0,
 )
+#: The CAM-style set (:func:`~nctwin.programs.camstyle.cam_program`): seed and size. Operations
+#: joined by rapids, engraving chords, 3D rasters, reversals, every path-control mode.
+CAM_SEED = 11
+N_CAM = 60
 #: Runs again after LinuxCNC aborted a program (busy machine), at half the speed-up after the
 #: first.
 RETRIES = 3
@@ -183,16 +189,18 @@ def recording_dir() -> Path:
     return data_dir() / "recordings" / "linuxcnc"
 
 
-def recording_programs(sets: tuple[str, ...] = ("train", "broad", "test")) -> dict[str, str]:
+def recording_programs(
+    sets: tuple[str, ...] = ("train", "broad", "cam", "test"),
+) -> dict[str, str]:
     """The shipped set: name -> G-code text (see the module docstring).
 
     ``train_*``: paper 1's training programs (:data:`N_PROGRAMS` of :data:`N_LINES` lines);
-    ``broad_*``: the broad set (:data:`BROAD`); ``test_*``: toolpaths I and II and the pocket.
-    ``sets`` picks some of them.
+    ``broad_*``: the broad set (:data:`BROAD`); ``cam_*``: the CAM-style set (:data:`N_CAM`
+    programs); ``test_*``: toolpaths I and II and the pocket. ``sets`` picks some of them.
     """
-    unknown = set(sets) - {"train", "broad", "test"}
+    unknown = set(sets) - {"train", "broad", "cam", "test"}
     if unknown:
-        raise ValueError(f"sets = {sets!r} is not allowed: allowed train, broad, test")
+        raise ValueError(f"sets = {sets!r} is not allowed: allowed train, broad, cam, test")
     out: dict[str, str] = {}
     specs = training_specs(
         RECORD_SEED,
@@ -206,6 +214,9 @@ def recording_programs(sets: tuple[str, ...] = ("train", "broad", "test")) -> di
     if "broad" in sets:
         rng = np.random.default_rng(BROAD_SEED)
         out |= {f"broad_{i:03d}": broad_program(rng, **BROAD) for i in range(N_BROAD)}
+    if "cam" in sets:
+        rng = np.random.default_rng(CAM_SEED)
+        out |= {f"cam_{i:03d}": cam_program(rng) for i in range(N_CAM)}
     for name in ("I", "II", "pocket") if "test" in sets else ():
         for f in TEST_FEEDS_MM_S:
             for e in TEST_TOLS_MM:
@@ -288,7 +299,7 @@ def record_set(
     *,
     n_jobs: int = 2,
     speed: float = 5,
-    sets: tuple[str, ...] = ("train", "broad", "test"),
+    sets: tuple[str, ...] = ("train", "broad", "cam", "test"),
 ) -> list[RecordedProgram]:
     """Record every program of :func:`recording_programs` and save them into ``folder``.
 
