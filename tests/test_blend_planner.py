@@ -9,14 +9,17 @@ import pytest
 
 from nctwin.estimate import estimate
 from nctwin.estimate.blend_planner import (
+    KINK_RATIO,
     MIN_SEGMENT_CYCLES,
     NORMAL_ACC_RATIO,
     OPTIMIZATION_DEPTH,
     STOP_TURN_RAD,
     blend_plane_acc,
+    junction_blends,
     move_limits,
     optimised_end_speeds,
     parabolic_junctions,
+    tangent_junctions,
 )
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
@@ -80,8 +83,11 @@ def test_corner_blend_arc():
 
 
 def test_exact_stop_and_dwell_stop_the_tool():
-    # G61: two lines at the full acceleration (LinuxCNC: 4.113 s, its stop settles ~6 ms)
-    assert time_s("G21 G90 G61\nG1 X100 F3000\nY100\n") == pytest.approx(2 * (2 + 0.05))
+    # G61: the corner is no tangent, so both lines stop at 0.9 a (tcSetKinkProperties):
+    # L/F + F/(0.9 a) each (LinuxCNC: 4.113 s)
+    assert time_s("G21 G90 G61\nG1 X100 F3000\nY100\n") == pytest.approx(2 * (2 + 50 / 900))
+    # G61.1: exact stop at the full acceleration
+    assert time_s("G21 G90 G61.1\nG1 X100 F3000\nY100\n") == pytest.approx(2 * (2 + 0.05))
     # a dwell: the move before it keeps its parabolic end, so both lines brake at a / 2
     # (LinuxCNC: 4.704 s)
     dwell = "G21 G90 G64 P0.1\nG1 X100 F3000\nG4 P0.5\nY100\n"
@@ -206,3 +212,46 @@ def test_an_arc_entered_from_outside_its_plane_gets_a_parabolic_blend():
     assert acc[1] == pytest.approx(125.0)
     # LinuxCNC: 1.806 s (the parabolic blend is modelled as one junction speed)
     assert time_s(program) == pytest.approx(1.806, rel=0.01)
+
+
+def test_tangent_junction_by_hand():
+    # two lines along X, the second turned by 0.001 rad in XY, at 60 mm/s: the kink costs
+    # (60 / 0.001 + 1000) * |u2 - u1| / 1000 = 61 * 0.001 = 0.061 of X's or Y's acceleration
+    tp = parse("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n", start_mm=(0, 0, 0))
+    feed, acc = move_limits(tp, MACHINE)
+    tangent, share = tangent_junctions(tp, feed, acc, AXIS_ACC, MACHINE.period_s)
+    turn = math.atan2(0.01, 10.0)
+    assert share[0] == pytest.approx(61.0 * turn, rel=1e-6)  # Y's component dominates
+    assert tangent[0] and share[0] < KINK_RATIO
+    # a turn twice as sharp, at twice the speed, is no longer tangent
+    tp2 = parse("G21 G90 G61\nG1 X10 F7200\nX20 Y0.02\n", start_mm=(0, 0, 0))
+    feed2, acc2 = move_limits(tp2, MACHINE)
+    assert not tangent_junctions(tp2, feed2, acc2, AXIS_ACC, MACHINE.period_s)[0][0]
+    # tangent: no stop, both lines at (1 - share) a; the last keeps its exact-path end (no a/2)
+    a = A * (1 - share[0])
+    total = trapezoid_s(10.0, 60.0, a, v1=60.0) + trapezoid_s(math.hypot(10, 0.01), 60.0, a, 60.0)
+    assert time_s("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n") == pytest.approx(total, rel=1e-3)
+
+
+def test_blend_arc_is_as_small_as_its_speed_allows():
+    # a 90-degree corner of two 100 mm lines, plain G64, at 10 mm/s: the tolerance would allow an
+    # arc of d = 25 mm, but the arc is sized for its speed: the larger of v^2 / a_n and the arc
+    # a parabolic blend would run, v t_b / phi with t_b = v / (a / 2) and phi = pi / 2;
+    # d = R / tan(45 deg) = R
+    tp = parse("G21 G90 G64\nG1 X100 F600\nY100\n", start_mm=(0, 0, 0))
+    feed, _ = move_limits(tp, MACHINE)
+    v, d, arc, _ = junction_blends(
+        tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
+    )
+    r = max(10.0**2 / (NORMAL_ACC_RATIO * A), 10.0 * (10.0 / (A / 2)) / (math.pi / 2))
+    assert r == pytest.approx(4 * 10.0**2 / (math.pi * A))  # the parabolic term binds
+    assert d[0] == pytest.approx(r) and arc[0] == pytest.approx(r * math.pi / 2)
+    assert v[0] == pytest.approx(10.0)
+    # at 150 mm/s: R = 2 v^2 / (a phi) = 28.6 mm, below the largest arc (d = R = 50 mm, half a
+    # line); at 200 mm/s, 2 v^2 / (a phi) = 50.9 mm > 50 mm: the largest arc
+    for f, expected in ((150.0, 4 * 150.0**2 / (math.pi * A)), (200.0, 50.0)):
+        feed[:] = f
+        d = junction_blends(
+            tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
+        )[1]
+        assert d[0] == pytest.approx(expected)

@@ -6,7 +6,6 @@ has no jerk limit, so a straight line from rest to rest with a trapezoidal feed 
 ``L / F + F / A``.
 """
 
-import glob
 import math
 import tempfile
 from pathlib import Path
@@ -156,8 +155,9 @@ def test_exact_stop_at_corner():
 #: with the full acceleration on the line before it, a chain of short blended lines, moves
 #: that turn back within 0.002 rad and stop, 300 moves of 0.2 mm held back by the look-ahead's
 #: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), a rapid followed
-#: by a feed move (no blend between them), and a corner of short moves before a long line (the
-#: lazy look-ahead's dip).
+#: by a feed move (no blend between them), a corner of short moves before a long line (the
+#: lazy look-ahead's dip), slow reversals whose blend arcs are as small as their speed allows,
+#: and G61 chords of a circle that LinuxCNC passes as tangent (R 500 mm) or stops at (R 20 mm).
 PLANNER_PROGRAMS = {
     "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
@@ -176,6 +176,26 @@ PLANNER_PROGRAMS = {
         for p in np.arange(1, 80) * math.pi / 158
     )
     + "Y60\nM2\n",
+    "slow_reversals": "G21 G90 G64\nG1 F1200\n"
+    + "".join(
+        f"X{x:.4f} Y{y:.4f}\n"
+        for x, y in np.cumsum(
+            [[10 * math.cos(h), 10 * math.sin(h)] for h in np.radians([0, 140, 0, 140, 0, 140])],
+            axis=0,
+        )
+    )
+    + "M2\n",
+    "g61_tangent": "G21 G90 G61\nG1 F1800\n"
+    + "".join(
+        f"X{500 * math.sin(k / 500):.4f} Y{500 - 500 * math.cos(k / 500):.4f}\n"
+        for k in range(1, 21)
+    )
+    + "M2\n",
+    "g61_stops": "G21 G90 G61\nG1 F1800\n"
+    + "".join(
+        f"X{20 * math.sin(k / 20):.4f} Y{20 - 20 * math.cos(k / 20):.4f}\n" for k in range(1, 11)
+    )
+    + "M2\n",
 }
 
 
@@ -197,9 +217,16 @@ def test_rejected_program_carries_linuxcnc_message():
 
 
 @live
-def test_timeout_kills_the_instance_and_leaves_nothing():
-    pattern = str(Path(tempfile.gettempdir()) / "nctwin-linuxcnc-*")
-    before = set(glob.glob(pattern))
+def test_timeout_kills_the_instance_and_leaves_nothing(monkeypatch):
+    # the instance's own folder, not every nctwin-linuxcnc-* (other runs may be going on)
+    made, original = [], tempfile.mkdtemp
+
+    def mkdtemp(**kwargs):
+        made.append(original(**kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(lc.tempfile, "mkdtemp", mkdtemp)
     with pytest.raises(TimeoutError, match="timeout_s"):
         lc.record("G21\nG4 P60\nM2\n", MACHINE, timeout_s=4.0)
-    assert set(glob.glob(pattern)) <= before
+    assert len(made) == 1 and Path(made[0]).name.startswith("nctwin-linuxcnc-")
+    assert not Path(made[0]).exists()

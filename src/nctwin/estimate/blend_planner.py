@@ -23,16 +23,26 @@ tangent :math:`u_1`, the second starting along :math:`u_2`:
   ``G64 P`` in force and a plain ``G64`` (no tolerance) means :math:`P = r L` of the move;
 * the largest distance from the corner along the moves the tolerance allows,
   :math:`d_{tol} = \cos\theta \, T / (1 - \sin\theta)`, and at most half of each move,
-  :math:`d = \min(d_{tol}, L_1/2, L_2/2)`; the blend radius :math:`R = d \tan\theta`, the arc
-  length :math:`R (\pi - 2\theta)`, and each move is shortened by :math:`d`;
+  :math:`d_g = \min(d_{tol}, L_1/2, L_2/2)`, the largest radius :math:`R_g = d_g \tan\theta`;
+  the arc is only as large as its planned speed
+  :math:`v_p = \min(\sqrt{a_n R_g}, \max(F_1, F_2))` needs (``blendComputeParameters``):
+  :math:`R = \max(v_p^2 / a_n, \min(v_p t_b / (\pi - 2\theta), R_g))` with the blend time
+  :math:`t_b = \min(\sqrt{a_j d_g}, v_p) / (a_j/2)`, so a slow or sharp corner gets a small arc;
+  the arc length is :math:`R (\pi - 2\theta)`, and each move is shortened by
+  :math:`d = R / \tan\theta`;
 * the blend arc's acceleration is that of its plane (``blendParamKinematics``,
   ``calculateInscribedDiameter``): :math:`a_j = \min_i a_{i,\max} / \sqrt{1 - n_i^2}` with
   :math:`n` the unit normal of the plane of :math:`u_1, u_2` (:func:`blend_plane_acc`: 1000
   mm/s² for any turn in XY on ``linuxcnc_sim``, 500 in any plane that holds Z);
 * the speed through the arc :math:`v_j = \min(\sqrt{a_n R}, F_1, F_2)` with
   :math:`a_n = \sqrt{1 - 0.5^2}\, a_j` and the tangential :math:`a_j/2` (``acc_ratio_tan``);
-* ``G61``/``G61.1``, a dwell, a change between rapid and feed motion (``tpCheckCanonType``) and
-  the program's ends stop the tool (:math:`v_j = 0`), and so does a turn within
+* first of all, a nearly tangent junction (:func:`tangent_junctions`, ``tpSetupTangent``) gets
+  no arc: the tool passes it at the feed, both moves at :math:`1 - k` of their acceleration,
+  in ``G64`` and in ``G61`` alike;
+* ``G61`` stops at every other junction, with both moves at :math:`1 -` :data:`KINK_RATIO` of
+  their acceleration (``tcSetKinkProperties``); ``G61.1``, a dwell, a change between rapid and
+  feed motion (``tpCheckCanonType``) and the program's ends stop the tool (:math:`v_j = 0`) at
+  the full acceleration, and so does a turn within
   :data:`STOP_TURN_RAD` of a reversal (:math:`2\theta` below it): measured on LinuxCNC, turns
   of :math:`\pi` - 0.002 to :math:`\pi` - 0.02 rad stop at the corner and :math:`\pi` - 0.05
   rad is blended (its source's own arc limit is 0.001 rad; what rejects the others is not
@@ -61,7 +71,7 @@ Item time: the trapezoid (or triangle) from :math:`v_j` to :math:`v_{j+1}` under
 Measured on LinuxCNC (``linuxcnc_sim``, recorded live; model in brackets): one 60 mm line at
 50 mm/s in the default ``G64``: 1.301 s (1.300); a 90° corner of two 100 mm lines at 50 mm/s,
 ``G64 P0.1``: 4.131 s (4.130), with a 0.5 s dwell instead of the blend: 4.704 s (4.700), under
-``G61``: 4.113 s (4.100); six 10 mm lines with 90° corners at 100 mm/s, ``G64 P0.1``: 1.244 s
+``G61``: 4.113 s (4.111); six 10 mm lines with 90° corners at 100 mm/s, ``G64 P0.1``: 1.244 s
 (1.242); 120° and 90° corners at 150 mm/s, ``G64 P0.5``: 1.082 s (1.080); four 25.4 mm moves
 that turn back within 0.002 rad, plain ``G64``: 1.519 s (1.516); collinear chains at 200 mm/s,
 plain ``G64``: 300 x 1 mm 1.740 s (1.739), 10 x 5 mm 0.528 s (0.526), 3 x 20 mm 0.616 s
@@ -80,16 +90,21 @@ check eight of these programs.
 
 Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits,
 the size limits of its blends between a line and an arc or two arcs (here the line-line formula
-on the tangents), the "kink" of nearly tangent junctions, and helical arcs' effective radius.
-The CAM-style recordings (:mod:`nctwin.programs.camstyle`), made after these rules were written,
-show what two of them cost. The kink: ``tpSetupTangent`` passes a junction whose turn is below
-about :math:`0.866 \cdot 0.25\, a\, T_s / v` without a blend and without a stop, in ``G61``
-too (only ``G61.1`` skips the check), so LinuxCNC runs a ``G61`` 3D raster of 0.3 mm steps at
-the feed where this model stops at every step (up to 59 % over); where the turn is larger it
-does stop (measured live, ``G61``, 10 mm circles of 20, 100 and 400 chords at 50 mm/s: 2.512,
-5.308 and 10.488 s; model 2.394, 5.000 and 9.752). On a plain ``G64`` LinuxCNC's blends where
-lines turn back by 150-180 degrees are far smaller than the half-move arcs taken here (up to
-20 % under).
+on the tangents), the speed limit of a junction that is not tangent but whose blend arc fails,
+a stop's extra servo periods, and helical arcs' effective radius.
+Three rules were added after the CAM-style recordings (:mod:`nctwin.programs.camstyle`) had
+shown the model wrong by up to 59 % (``G61`` 3D rasters, stopped at every 0.3 mm step where
+LinuxCNC passes them as tangent) and 20 % (slow reversals on a plain ``G64``, whose arcs were
+taken as large as the tolerance allows): the tangent junctions, the blend arc sized for its
+speed, and ``G61``'s reduced acceleration, each read in LinuxCNC's source and checked live:
+``G61``, 20 chords of 1 mm on a 500 mm radius at 30 mm/s (tangent): 0.699 s (0.701); 10
+chords of 1 mm on a 20 mm radius (stops): 0.657 s (0.653); 100 chords of 0.3 mm on 50 mm at
+60 mm/s: 3.594 s (3.541; ``G61.1`` on 500 mm: 3.500 s, 3.463: LinuxCNC takes about 0.4 ms
+more per stop than a trapezoid); 10 mm circles of 20, 100 and 400 chords at 50 mm/s: 2.512,
+5.308 and 10.488 s (2.499, 5.262 and 10.271: the same per-stop time); plain
+``G64``, six 10 mm moves turning by 140 degrees at 20 mm/s: 2.673 s (2.673), by 160 degrees
+at 6 mm/s: 9.713 s (9.713), by 170 degrees at 60 mm/s: 1.070 s (1.070); 20 mm moves turning
+by 60 degrees at 30 mm/s: 5.332 s (5.331, 4.940 with the largest arcs).
 """
 
 from __future__ import annotations
@@ -102,10 +117,11 @@ from numba import njit
 
 from ..machine import MachineProfile
 from ..naivecam import merge_naive_cam
-from ..toolpath import MotionKind, Toolpath
+from ..toolpath import MotionKind, PathMode, Toolpath
 from .result import Estimate
 
 __all__ = [
+    "KINK_RATIO",
     "NORMAL_ACC_RATIO",
     "STOP_TURN_RAD",
     "TANGENTIAL_ACC_RATIO",
@@ -132,6 +148,9 @@ OPTIMIZATION_CUTOFF = 4
 #: A line remainder shorter than this many periods at the next arc's speed joins the arc
 #: (``ARC_BLEND_GAP_CYCLES``).
 GAP_CYCLES = 4
+#: A junction whose kink needs less than this share of an axis's acceleration is passed as
+#: tangent, without a blend arc or a stop (``ARC_BLEND_TANGENT_KINK_RATIO``, default 0.1).
+KINK_RATIO = 0.1
 
 
 def move_limits(
@@ -259,8 +278,16 @@ def junction_blends(
     acc = blend_plane_acc(u1, u2, axis_acc_mm_s2)
     with np.errstate(divide="ignore", invalid="ignore"):
         d_tol = np.cos(theta) * tol / (1.0 - sin_t)
-        d = np.minimum(np.minimum(l1, l2) / 2.0, d_tol)
-        radius = np.where(straight, np.inf, np.tan(theta) * d)
+        d_geom = np.minimum(np.minimum(l1, l2) / 2.0, d_tol)
+        r_geom = np.tan(theta) * d_geom
+        # the arc is only as large as the planned speed needs (blendComputeParameters)
+        a_n = NORMAL_ACC_RATIO * acc
+        v_plan = np.minimum(np.sqrt(a_n * r_geom), np.maximum(feed_mm_s[:-1], feed_mm_s[1:]))
+        a_para = TANGENTIAL_ACC_RATIO * acc
+        t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
+        r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_geom)
+        radius = np.where(straight, np.inf, np.maximum(v_plan**2 / a_n, r_blend))
+        d = np.where(straight, d_geom, radius / np.tan(theta))
         v = np.minimum(
             np.sqrt(NORMAL_ACC_RATIO * acc * radius), np.minimum(feed_mm_s[:-1], feed_mm_s[1:])
         )
@@ -268,6 +295,49 @@ def junction_blends(
     arc = (v > 0) & ~straight
     arc_radius = np.where(arc, radius, 0.0)
     return v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), acc
+
+
+def tangent_junctions(
+    moves: Toolpath,
+    feed_mm_s: np.ndarray,
+    acc_mm_s2: np.ndarray,
+    axis_acc_mm_s2: np.ndarray,
+    period_s: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    r"""Junctions of M moves that LinuxCNC passes as tangent (``tpSetupTangent``), (M - 1,).
+
+    Before it makes a blend arc, LinuxCNC asks what the kink would cost: the change of
+    direction at the speed :math:`v = \min(v_1, v_2)` (each move's feed within its limits and
+    its length per :data:`MIN_SEGMENT_CYCLES` periods) in one servo period, plus the next
+    move's acceleration, :math:`\Delta a = (v / T_s + a_2)(u_2 - u_1)`, as a share of each
+    axis's limit, :math:`k = \max_i |\Delta a_i| / a_{i,\max}` (doubled where an arc takes
+    part). Where :math:`k` < :data:`KINK_RATIO` the junction is tangent: no blend arc, no stop,
+    in ``G61`` (exact path) too, and both moves accelerate at :math:`1 - k` of their limit
+    (``tcGetOverallMaxAccel``).
+
+    Parameters
+    ----------
+    moves : Toolpath
+        M moves of non-zero length.
+    feed_mm_s, acc_mm_s2 : ndarray, shape (M,)
+        Feed and acceleration of each move (:func:`move_limits`).
+    axis_acc_mm_s2 : ndarray, shape (3,)
+    period_s : float
+        Servo period.
+
+    Returns
+    -------
+    tangent : ndarray of bool, shape (M - 1,)
+    kink_share : ndarray, shape (M - 1,)
+        :math:`k` of each junction.
+    """
+    u1, u2 = moves.end_tangents[:-1], moves.start_tangents[1:]
+    v = np.minimum(feed_mm_s, moves.lengths_mm / (MIN_SEGMENT_CYCLES * period_s))
+    a_inst = np.minimum(v[:-1], v[1:]) / period_s + acc_mm_s2[1:]
+    share = np.max(np.abs(a_inst[:, None] * (u2 - u1)) / np.asarray(axis_acc_mm_s2), axis=1)
+    arc = moves.is_arc
+    share = np.where(arc[:-1] | arc[1:], share / TANGENTIAL_ACC_RATIO, share)
+    return share < KINK_RATIO, share
 
 
 def parabolic_junctions(moves: Toolpath, tol_mm: np.ndarray) -> np.ndarray:
@@ -483,23 +553,39 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     rapid = moves.kind == MotionKind.RAPID
     tol[1:][rapid[1:] != rapid[:-1]] = 0.0
     axis_acc = np.asarray(machine.axis_max_acceleration_mm_s2)
+    # nearly tangent junctions (but not into an exact stop): no blend arc, no stop, both moves
+    # at 1 - k of their acceleration; the other G61 junctions stop with both moves at
+    # 1 - KINK_RATIO (tcSetKinkProperties, kept where no blend arc replaces the kink)
+    stop = (tol[1:] == 0) & (moves.path_mode[:-1] != PathMode.EXACT_PATH)
+    tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, machine.period_s)
+    tangent &= ~stop
+    exact = (tol[1:] == 0) & ~stop & ~tangent
+    reduce = np.where(tangent, kink, np.where(exact, KINK_RATIO, 0.0))
+    kept = np.ones(len(moves))
+    kept[:-1] = 1.0 - reduce
+    kept[1:] = np.minimum(kept[1:], 1.0 - reduce)
+    if (reduce > 0).any():
+        feed, acc = move_limits(moves, machine, kept)
     v, d, arc, arc_acc = junction_blends(
         length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc
     )
     # junctions with an arc that get no blend arc: a parabolic blend, both moves at half their
     # acceleration (halved once, with a parabolic end too)
-    para = parabolic_junctions(moves, tol)
+    para = parabolic_junctions(moves, tol) & ~tangent
     halved = np.zeros(len(moves), bool)
     halved[:-1] |= para
     halved[1:] |= para
     if para.any():
-        feed, acc = move_limits(moves, machine, np.where(halved, TANGENTIAL_ACC_RATIO, 1.0))
+        feed, acc = move_limits(moves, machine, kept * np.where(halved, TANGENTIAL_ACC_RATIO, 1.0))
         speed = parabolic_blend_speeds(
             length, feed, acc, moves.end_tangents, moves.start_tangents, tol
         )
         v = np.where(para, speed, v)
         d = np.where(para, 0.0, d)
         arc = np.where(para, 0.0, arc)
+    v = np.where(tangent, np.minimum(feed[:-1], feed[1:]), v)
+    d = np.where(tangent, 0.0, d)
+    arc = np.where(tangent, 0.0, arc)
     # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed
     a_line = acc * np.where(parabolic_end & ~halved, TANGENTIAL_ACC_RATIO, 1.0)
     v = np.where(parabolic_end[1:], np.minimum(v, np.sqrt(a_line * length)[1:]), v)
