@@ -160,3 +160,16 @@ def test_planner_rows_need_the_program_text():
     rec = _recording("public_x", "", 1.0, source="public/x.ngc")
     with pytest.raises(ValueError, match=r"source = 'public/x\.ngc'"):
         rk.planner_rows({"public_x": rec}, MACHINE)
+
+
+def test_planner_ablation_by_hand():
+    # G61, two lines with a 0.001 rad kink at 60 mm/s: tangent with the kink rule, a stop at
+    # full acceleration without it (the sizes of blend arcs do not matter: there are none)
+    tp = parse("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n", start_mm=(0, 0, 0))
+    rows = rk.planner_ablation({"kink": ("test", tp, 1.0)}, MACHINE)
+    assert list(rows.rules) == list(rk.PLANNER_RULES)
+    t = dict(zip(rows.rules, rows.predicted_s, strict=True))
+    stop = 2 * (10 / 60 + 60 / 1000)  # two trapezoids from rest to rest (L/F + F/a)
+    assert t["no kinks"] == t["neither"] == pytest.approx(stop, rel=1e-5)
+    assert t["all"] == t["largest arcs"] < stop - 0.05
+    np.testing.assert_allclose(rows.err_pct, 100 * (rows.predicted_s - 1.0))

@@ -65,6 +65,7 @@ __all__ = [
     "FEATURES",
     "FIR_FIELDS",
     "METHOD_COLUMNS",
+    "PLANNER_RULES",
     "TIME_TARGETS",
     "TOL_CAP_MM",
     "TRAINING_SETS",
@@ -82,6 +83,7 @@ __all__ = [
     "model_blocks",
     "move_data",
     "path_control",
+    "planner_ablation",
     "planner_block_gaps",
     "planner_rows",
     "predict_axis_nn",
@@ -531,6 +533,45 @@ def planner_rows(recordings: dict[str, RecordedProgram], machine: MachineProfile
              "mode": path_control(tp, machine)}
         )  # fmt: skip
     return pd.DataFrame(rows, columns=[*METHOD_COLUMNS, "mode"])
+
+
+#: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
+#: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
+#: before the CAM-style recordings showed the two rules missing.
+PLANNER_RULES = {
+    "all": {},
+    "no kinks": {"kinks": False},
+    "largest arcs": {"sized_arcs": False},
+    "neither": {"kinks": False, "sized_arcs": False},
+}
+
+
+def planner_ablation(
+    programs: dict[str, tuple[str, Toolpath, float]], machine: MachineProfile
+) -> pd.DataFrame:
+    """The blend-arc planner with and without its rules for nearly tangent junctions and for
+    the size of blend arcs (:data:`PLANNER_RULES`).
+
+    Parameters
+    ----------
+    programs : dict
+        Name -> (set, parsed program, recorded cycle time in s).
+
+    Returns
+    -------
+    DataFrame
+        One row per program x rule set: ``program``, ``set``, ``rules``, ``measured_s``,
+        ``predicted_s`` and the signed ``err_pct``.
+    """
+    rows = []
+    for name, (group, tp, measured) in programs.items():
+        for rules, kwargs in PLANNER_RULES.items():
+            t = blend_planner(tp, machine, **kwargs).cycle_time_s
+            rows.append(
+                {"program": name, "set": group, "rules": rules, "measured_s": measured,
+                 "predicted_s": t, "err_pct": 100.0 * (t - measured) / measured}
+            )  # fmt: skip
+    return pd.DataFrame(rows)
 
 
 def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3) -> pd.DataFrame:

@@ -239,6 +239,8 @@ def junction_blends(
     feed_mm_s: np.ndarray,
     tol_mm: np.ndarray,
     axis_acc_mm_s2: np.ndarray,
+    *,
+    sized_arcs: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Blend arcs at the junctions of M moves: speed limit, consumed length, arc length and the
     arc's acceleration.
@@ -253,6 +255,9 @@ def junction_blends(
         Blending tolerance the move starts with (``inf``: no tolerance, 0: exact stop).
     axis_acc_mm_s2 : ndarray, shape (3,)
         Acceleration limit of each axis.
+    sized_arcs : bool
+        Size each arc for its planned speed (LinuxCNC); False takes the largest arc the
+        tolerance and the moves allow (the ablation of the chapter).
 
     Returns
     -------
@@ -286,7 +291,8 @@ def junction_blends(
         a_para = TANGENTIAL_ACC_RATIO * acc
         t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
         r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_geom)
-        radius = np.where(straight, np.inf, np.maximum(v_plan**2 / a_n, r_blend))
+        r_plan = np.maximum(v_plan**2 / a_n, r_blend) if sized_arcs else r_geom
+        radius = np.where(straight, np.inf, r_plan)
         d = np.where(straight, d_geom, radius / np.tan(theta))
         v = np.minimum(
             np.sqrt(NORMAL_ACC_RATIO * acc * radius), np.minimum(feed_mm_s[:-1], feed_mm_s[1:])
@@ -518,7 +524,9 @@ def optimised_end_speeds(
     )
 
 
-def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+def blend_planner(
+    toolpath: Toolpath, machine: MachineProfile, *, kinks: bool = True, sized_arcs: bool = True
+) -> Estimate:
     """Cycle time on the blend-arc look-ahead planner (see the module docstring).
 
     Parameters
@@ -527,6 +535,10 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
         N blocks (arcs are taken as chords).
     machine : MachineProfile
         Axis velocity and acceleration limits, maximum and rapid feed, period, tolerance.
+    kinks, sized_arcs : bool
+        LinuxCNC's rules for nearly tangent junctions and G61's reduced acceleration
+        (:func:`tangent_junctions`), and for the size of blend arcs (:func:`junction_blends`);
+        both on by default, off only for the ablation that shows what each is worth.
 
     Returns
     -------
@@ -558,8 +570,8 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     # 1 - KINK_RATIO (tcSetKinkProperties, kept where no blend arc replaces the kink)
     stop = (tol[1:] == 0) & (moves.path_mode[:-1] != PathMode.EXACT_PATH)
     tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, machine.period_s)
-    tangent &= ~stop
-    exact = (tol[1:] == 0) & ~stop & ~tangent
+    tangent &= ~stop & kinks
+    exact = (tol[1:] == 0) & ~stop & ~tangent & kinks
     reduce = np.where(tangent, kink, np.where(exact, KINK_RATIO, 0.0))
     kept = np.ones(len(moves))
     kept[:-1] = 1.0 - reduce
@@ -567,7 +579,7 @@ def blend_planner(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
     if (reduce > 0).any():
         feed, acc = move_limits(moves, machine, kept)
     v, d, arc, arc_acc = junction_blends(
-        length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc
+        length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc, sized_arcs=sized_arcs
     )
     # junctions with an arc that get no blend arc: a parabolic blend, both moves at half their
     # acceleration (halved once, with a parabolic end too)
