@@ -284,19 +284,17 @@ def junction_blends(
     with np.errstate(divide="ignore", invalid="ignore"):
         d_tol = np.cos(theta) * tol / (1.0 - sin_t)
         d_geom = np.minimum(np.minimum(l1, l2) / 2.0, d_tol)
-        r_geom = np.tan(theta) * d_geom
-        # the arc is only as large as the planned speed needs (blendComputeParameters)
+        r_plan = np.tan(theta) * d_geom
         a_n = NORMAL_ACC_RATIO * acc
-        v_plan = np.minimum(np.sqrt(a_n * r_geom), np.maximum(feed_mm_s[:-1], feed_mm_s[1:]))
-        a_para = TANGENTIAL_ACC_RATIO * acc
-        t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
-        r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_geom)
-        r_plan = np.maximum(v_plan**2 / a_n, r_blend) if sized_arcs else r_geom
+        if sized_arcs:  # the arc is only as large as its planned speed needs
+            v_plan = np.minimum(np.sqrt(a_n * r_plan), np.maximum(feed_mm_s[:-1], feed_mm_s[1:]))
+            a_para = TANGENTIAL_ACC_RATIO * acc
+            t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
+            r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_plan)
+            r_plan = np.maximum(v_plan**2 / a_n, r_blend)
         radius = np.where(straight, np.inf, r_plan)
         d = np.where(straight, d_geom, radius / np.tan(theta))
-        v = np.minimum(
-            np.sqrt(NORMAL_ACC_RATIO * acc * radius), np.minimum(feed_mm_s[:-1], feed_mm_s[1:])
-        )
+        v = np.minimum(np.sqrt(a_n * radius), np.minimum(feed_mm_s[:-1], feed_mm_s[1:]))
     v = np.where((p > 0) & (2.0 * theta >= STOP_TURN_RAD), v, 0.0)
     arc = (v > 0) & ~straight
     arc_radius = np.where(arc, radius, 0.0)
