@@ -123,13 +123,15 @@ def _recording(name: str, program: str, time_s: float, source: str = "nctwin") -
     return RecordedProgram(name, program, MACHINE.name, targets, np.zeros(1), 0, "", "", source)
 
 
-def test_planner_rows_on_recordings_by_hand():
+def test_planner_ablation_on_recordings_by_hand():
     # G61: 60/50 + 50/1000 = 1.25 s; plain G64, last move at a/2: 60/50 + 50/500 = 1.3 s
     recs = {
         "train_a": _recording("train_a", "G21 G90 G61\nG1 X60 F3000\n", 1.25),
         "broad_b": _recording("broad_b", "G21 G90 G64\nG1 X60 F3000\n", 1.3 * 1.04),
     }
-    rows = rk.planner_rows(recs, MACHINE)
+    programs = {n: (n.split("_")[0], parse(r.program), r.cycle_time_s) for n, r in recs.items()}
+    rows = rk.planner_ablation(programs, MACHINE)
+    rows = rows[rows.rules == "all"]
     assert list(rows.set) == ["train", "broad"]
     assert list(rows["mode"]) == ["G61", "G64"]
     np.testing.assert_allclose(rows.predicted_s, [1.25, 1.3])
@@ -156,10 +158,10 @@ def test_path_control_follows_linuxcnc(program, mode):
     assert rk.path_control(parse("G21 G90\n" + program), MACHINE) == mode
 
 
-def test_planner_rows_need_the_program_text():
+def test_planner_block_gaps_need_the_program_text():
     rec = _recording("public_x", "", 1.0, source="public/x.ngc")
     with pytest.raises(ValueError, match=r"source = 'public/x\.ngc'"):
-        rk.planner_rows({"public_x": rec}, MACHINE)
+        rk.planner_block_gaps(rec, MACHINE)
 
 
 def test_planner_ablation_by_hand():

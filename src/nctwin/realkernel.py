@@ -85,7 +85,6 @@ __all__ = [
     "path_control",
     "planner_ablation",
     "planner_block_gaps",
-    "planner_rows",
     "predict_axis_nn",
     "predict_bilstm",
     "recorded_move_data",
@@ -504,37 +503,6 @@ def path_control(tp: Toolpath, machine: MachineProfile) -> str:
     return ", ".join(label[np.sort(first)])
 
 
-def planner_rows(recordings: dict[str, RecordedProgram], machine: MachineProfile) -> pd.DataFrame:
-    """The blend-arc planner alone on recordings of nctwin's own programs.
-
-    The planner learns nothing from recordings, so the training sets are held-out programs for
-    it: a check of its rules on programs that were not used to find them.
-
-    Parameters
-    ----------
-    recordings : dict
-        Name -> :class:`~nctwin.recordings.RecordedProgram` with its text (``source`` =
-        ``nctwin``); the set is the name's prefix (``train``, ``broad``, ``cam``, ``test``).
-
-    Returns
-    -------
-    DataFrame
-        Columns :data:`METHOD_COLUMNS` and ``mode``, the program's :func:`path_control`;
-        ``err_pct`` is signed.
-    """
-    rows = []
-    for name, rec in recordings.items():
-        tp = _own_program(name, rec)
-        t = blend_planner(tp, machine).cycle_time_s
-        rows.append(
-            {"program": name, "set": name.split("_", 1)[0], "method": "planner",
-             "measured_s": rec.cycle_time_s, "predicted_s": t,
-             "err_pct": 100.0 * (t - rec.cycle_time_s) / rec.cycle_time_s,
-             "mode": path_control(tp, machine)}
-        )  # fmt: skip
-    return pd.DataFrame(rows, columns=[*METHOD_COLUMNS, "mode"])
-
-
 #: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
 #: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
 #: before the CAM-style recordings showed the two rules missing.
@@ -552,6 +520,9 @@ def planner_ablation(
     """The blend-arc planner with and without its rules for nearly tangent junctions and for
     the size of blend arcs (:data:`PLANNER_RULES`).
 
+    The planner learns nothing from recordings, so for it the training sets are held-out
+    programs: a check of its rules on programs that were not used to find them.
+
     Parameters
     ----------
     programs : dict
@@ -560,16 +531,19 @@ def planner_ablation(
     Returns
     -------
     DataFrame
-        One row per program x rule set: ``program``, ``set``, ``rules``, ``measured_s``,
-        ``predicted_s`` and the signed ``err_pct``.
+        One row per program x rule set: ``program``, ``set``, ``mode`` (the program's
+        :func:`path_control`), ``rules``, ``measured_s``, ``predicted_s`` and the signed
+        ``err_pct``.
     """
     rows = []
     for name, (group, tp, measured) in programs.items():
+        mode = path_control(tp, machine)
         for rules, kwargs in PLANNER_RULES.items():
             t = blend_planner(tp, machine, **kwargs).cycle_time_s
             rows.append(
-                {"program": name, "set": group, "rules": rules, "measured_s": measured,
-                 "predicted_s": t, "err_pct": 100.0 * (t - measured) / measured}
+                {"program": name, "set": group, "mode": mode, "rules": rules,
+                 "measured_s": measured, "predicted_s": t,
+                 "err_pct": 100.0 * (t - measured) / measured}
             )  # fmt: skip
     return pd.DataFrame(rows)
 
@@ -580,7 +554,12 @@ def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3
     (s), sorted by block."""
     if not (isinstance(n, int) and n >= 1):
         raise ValueError(f"n = {n!r} is out of range: allowed integers >= 1")
-    tp = _own_program(rec.name, rec)
+    if rec.source != "nctwin":
+        raise ValueError(
+            f"recording {rec.name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
+            "whose text is shipped)"
+        )
+    tp = parse(rec.program)
     planned = blend_planner(tp, machine).block_times_s
     measured = rec.targets.time_s
     worst = np.sort(np.argsort(-np.abs(planned - measured), kind="stable")[:n])
@@ -589,16 +568,6 @@ def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3
          "length_mm": tp.lengths_mm[worst], "feed_mm_s": tp.feed_mm_s[worst],
          "measured_s": measured[worst], "planner_s": planned[worst]}
     )  # fmt: skip
-
-
-def _own_program(name: str, rec: RecordedProgram) -> Toolpath:
-    """The parsed text of a recording of one of nctwin's programs."""
-    if rec.source != "nctwin":
-        raise ValueError(
-            f"recording {name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
-            "whose text is shipped)"
-        )
-    return parse(rec.program)
 
 
 def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) -> pd.DataFrame:
