@@ -26,6 +26,8 @@ import math
 
 import numpy as np
 
+from .training import _log_uniform, _rng
+
 __all__ = ["CAM_KINDS", "PATH_MODES", "cam_program"]
 
 #: Kinds of cutting operation, drawn with equal probability.
@@ -36,10 +38,6 @@ PATH_MODES = {"G64": 0.3, "G64 P": 0.25, "G64 P Q0": 0.3, "G61": 0.15}
 SAFE_Z_MM = 5.0
 #: Largest number of points of one raster.
 MAX_RASTER_POINTS = 3000
-
-
-def _log_uniform(rng: np.random.Generator, lo: float, hi: float) -> float:
-    return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
 
 
 def _engrave(rng: np.random.Generator) -> np.ndarray:
@@ -116,7 +114,7 @@ def cam_program(
     """
     if not (isinstance(max_operations, int) and max_operations >= 1):
         raise ValueError(f"max_operations = {max_operations!r} is out of range: allowed >= 1")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    rng = _rng(seed)
     feed = round(_log_uniform(rng, *feed_range_mm_s), 1)
     modes = list(PATH_MODES)
     mode = modes[int(rng.choice(len(modes), p=list(PATH_MODES.values())))]
