@@ -1,6 +1,7 @@
 """The chapter "Predicting a real controller" (nctwin.realkernel): moves, features and LinuxCNC's
 rules, checked on programs small enough to work out by hand."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -175,3 +176,41 @@ def test_planner_ablation_by_hand():
     assert t["no kinks"] == t["neither"] == pytest.approx(stop, rel=1e-5)
     assert t["all"] == t["largest arcs"] < stop - 0.05
     np.testing.assert_allclose(rows.err_pct, 100 * (rows.predicted_s - 1.0))
+
+
+def test_fit_planner_recovers_the_limits_that_made_the_times():
+    # "recordings" made by the planner itself on a machine with other limits: moves that need
+    # every axis's acceleration (short moves) and velocity (rapids along one axis, fast Z)
+    truth = dataclasses.replace(
+        MACHINE,
+        axis_max_acceleration_mm_s2=(800.0, 1200.0, 300.0),
+        axis_max_velocity_mm_s=(150.0, 180.0, 60.0),
+    )
+    texts = [
+        "G21 G90 G61\nG1 X5 F6000\nG1 X10\nG1 X0 Y0\n",
+        "G21 G90 G61\nG1 Y5 F6000\nG1 Y10\nG1 X3 Y0\n",
+        "G21 G90 G61\nG1 Z2 F6000\nG1 Z4\nG1 Z0\n",
+        "G21 G90\nG0 X200\nG0 X0\n",
+        "G21 G90\nG0 Y200\nG0 Y0\n",
+        "G21 G90\nG1 Z100 F12000\nG1 Z0\n",
+        "G21 G90 G64 P0.1\nG1 X20 Y20 Z5 F3000\nG1 X40 Y0 Z0\nG1 X0 Y-20 Z5\n",
+    ]
+    programs = []
+    for text in texts:
+        tp = parse(text, start_mm=(0, 0, 0))
+        programs.append((tp, estimate(tp, truth, "planner").cycle_time_s))
+    fit = rk.fit_planner(programs, MACHINE)
+    np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=1e-3)
+    np.testing.assert_allclose(fit.machine.axis_max_velocity_mm_s, (150, 180, 60), rtol=1e-3)
+    assert fit.max_err_pct < 1e-3
+    assert list(fit.limits.profile) == [1000, 1000, 500, 200, 200, 100]
+
+
+def test_fit_planner_rejects_bad_input():
+    tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
+    with pytest.raises(ValueError, match="programs is empty"):
+        rk.fit_planner([], MACHINE)
+    with pytest.raises(ValueError, match="allowed > 0"):
+        rk.fit_planner([(tp, 0.0)], MACHINE)
+    with pytest.raises(ValueError, match=r"start = \(500.0, 400.0\) is out of range"):
+        rk.fit_planner([(tp, 1.0)], MACHINE, start=(500.0, 400.0))

@@ -13,7 +13,9 @@ runs every method on a program the way the chapter "Predicting a real controller
 * ``axis_nn``: Sun et al. (2022)'s per-axis networks trained on the recordings
   (:func:`train_axis_nns`);
 * ``planner``: no paper's method, the blend-arc look-ahead planner of
-  :mod:`nctwin.estimate.blend_planner`, LinuxCNC's rules written down as physics.
+  :mod:`nctwin.estimate.blend_planner`, LinuxCNC's rules written down as physics;
+* ``planner_fitted``: the same planner with the six axis limits it reads from the profile
+  identified from the training recordings instead (:func:`fit_planner`).
 
 The learned methods see a program as its *moves* (:func:`model_blocks`): lines, rapids (a line at
 the rapid feed) and arcs cut into chords of at most :data:`ARC_CHORD_RAD`, the way the training
@@ -43,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from scipy.optimize import least_squares
 
 from .estimate import Estimate, block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner, move_limits
@@ -65,11 +68,13 @@ __all__ = [
     "FEATURES",
     "FIR_FIELDS",
     "METHOD_COLUMNS",
+    "PLANNER_FIT_START",
     "PLANNER_RULES",
     "TIME_TARGETS",
     "TOL_CAP_MM",
     "TRAINING_SETS",
     "MoveData",
+    "PlannerFit",
     "axis_nn_estimate",
     "axis_nn_move_times",
     "best_method",
@@ -77,6 +82,7 @@ __all__ = [
     "bilstm_move_times",
     "features",
     "fit_fir",
+    "fit_planner",
     "identified_block_overlap_machine",
     "method_rows",
     "method_summary",
@@ -426,16 +432,128 @@ def fit_fir(
     return dataclasses.replace(machine, **{n: best[n] for n in FIR_FIELDS}), trials
 
 
-def analytic_times(tp: Toolpath, machine: MachineProfile, fir_fitted: MachineProfile) -> dict:
-    """Cycle times of the methods that need no training data: CAM, Lee's block overlap with
-    identified constants, the fitted FIR kernel, and the blend-arc planner
-    (:mod:`nctwin.estimate.blend_planner`)."""
+#: Generic start of :func:`fit_planner`: every axis at this acceleration (mm/s^2) and velocity
+#: (mm/s), not the profile's.
+PLANNER_FIT_START = (500.0, 100.0)
+
+
+@dataclass(frozen=True)
+class PlannerFit:
+    """What :func:`fit_planner` identified.
+
+    Parameters
+    ----------
+    machine : MachineProfile
+        The profile with the identified axis limits.
+    limits : DataFrame
+        One row per axis and limit: ``axis``, ``limit`` (``acceleration_mm_s2`` or
+        ``velocity_mm_s``), ``start``, ``fitted``, ``profile`` (the value the profile had).
+    mean_err_pct, max_err_pct : float
+        Mean and largest absolute cycle-time error (%) on the fitted programs.
+    evaluations : int
+        Planner runs over the programs the fit took.
+    """
+
+    machine: MachineProfile
+    limits: pd.DataFrame
+    mean_err_pct: float
+    max_err_pct: float
+    evaluations: int
+
+
+def fit_planner(
+    programs: Sequence[tuple[Toolpath, float]],
+    machine: MachineProfile,
+    start: tuple[float, float] = PLANNER_FIT_START,
+) -> PlannerFit:
+    r"""Identify the blend-arc planner's axis limits from recorded cycle times.
+
+    The planner's rules are LinuxCNC's (:mod:`nctwin.estimate.blend_planner`); its constants are
+    the six axis limits it reads from the profile, :math:`a_{i,\max}` and :math:`v_{i,\max}`
+    for X, Y and Z, which a user of a control need not know. They are fitted here, without the
+    profile's values, by least squares on the log ratio of planned to recorded cycle time per
+    program: scipy's trust-region reflective method on the logarithm of each limit, with
+    finite differences of relative step 1e-3, from the generic ``start`` (every axis at the
+    same acceleration and velocity). The velocities are bounded by the profile's maximum feed
+    (``[TRAJ] MAX_LINEAR_VELOCITY``): an axis limit above the path's is never reached, and no
+    recording can tell it. Everything else in the profile (maximum and rapid feed, servo period,
+    default tolerance) is kept.
+
+    Parameters
+    ----------
+    programs : sequence of (Toolpath, float)
+        Training programs and their recorded cycle times.
+    machine : MachineProfile
+        The recorded machine's profile (its axis limits are only reported, not used).
+    start : (float, float)
+        Acceleration (mm/s^2) and velocity (mm/s) every axis starts from.
+
+    Returns
+    -------
+    PlannerFit
+
+    Raises
+    ------
+    ValueError
+        If there are no programs, a recorded time is not positive, or ``start`` lies outside
+        the bounds (acceleration 10 to 1e5 mm/s^2, velocity 1 mm/s to the maximum feed).
+    """
+    if not programs:
+        raise ValueError("programs is empty: the planner's limits need at least one recording")
+    measured = np.array([t for _, t in programs], dtype=float)
+    if not (measured > 0).all():
+        raise ValueError(f"measured cycle times {measured[measured <= 0][:3]} s: allowed > 0")
+    lower = np.log([10.0] * 3 + [1.0] * 3)
+    upper = np.log([1e5] * 3 + [machine.max_feed_mm_s] * 3)
+    x0 = np.log([start[0]] * 3 + [start[1]] * 3)
+    if not ((x0 >= lower) & (x0 <= upper)).all():
+        raise ValueError(
+            f"start = {start!r} is out of range: allowed acceleration [10, 1e5] mm/s^2, "
+            f"velocity [1, {machine.max_feed_mm_s:g}] mm/s"
+        )
+
+    def profile(x: np.ndarray) -> MachineProfile:
+        e = np.exp(x)
+        return dataclasses.replace(
+            machine,
+            axis_max_acceleration_mm_s2=tuple(float(v) for v in e[:3]),
+            axis_max_velocity_mm_s=tuple(float(v) for v in e[3:]),
+        )
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        m = profile(x)
+        planned = np.array([blend_planner(tp, m).cycle_time_s for tp, _ in programs])
+        return np.log(planned / measured)
+
+    fit = least_squares(residual, x0, bounds=(lower, upper), diff_step=1e-3, method="trf")
+    fitted = profile(fit.x)
+    err = 100 * np.abs(np.expm1(residual(fit.x)))
+    limits = pd.DataFrame(
+        [{"axis": axis, "limit": limit, "start": s, "fitted": getattr(fitted, field)[i],
+          "profile": getattr(machine, field)[i]}
+         for limit, field, s in (("acceleration_mm_s2", "axis_max_acceleration_mm_s2", start[0]),
+                                 ("velocity_mm_s", "axis_max_velocity_mm_s", start[1]))
+         for i, axis in enumerate("XYZ")]
+    )  # fmt: skip
+    return PlannerFit(fitted, limits, float(err.mean()), float(err.max()), int(fit.nfev))
+
+
+def analytic_times(
+    tp: Toolpath,
+    machine: MachineProfile,
+    fir_fitted: MachineProfile,
+    planner_fitted: MachineProfile,
+) -> dict:
+    """Cycle times of the methods that need no training data, or only constants fitted to it:
+    CAM, Lee's block overlap with identified constants, the fitted FIR kernel, the blend-arc
+    planner (:mod:`nctwin.estimate.blend_planner`) and the same with fitted axis limits."""
     lee = identified_block_overlap_machine(tp, machine)
     return {
         "cam": cam(tp, machine).cycle_time_s,
         "block_overlap": block_overlap(tp, lee).cycle_time_s,
         "kernel": kernel(tp, fir_fitted).cycle_time_s,
         "planner": blend_planner(tp, machine).cycle_time_s,
+        "planner_fitted": blend_planner(tp, planner_fitted).cycle_time_s,
     }
 
 
@@ -453,6 +571,7 @@ def method_rows(
     programs: dict[str, tuple[str, Toolpath, MoveData]],
     machine: MachineProfile,
     fir_fitted: MachineProfile,
+    planner_fitted: MachineProfile,
     bilstm: Trained,
     axis_nns: Sequence[Trained],
 ) -> pd.DataFrame:
@@ -471,7 +590,7 @@ def method_rows(
     """
     rows = []
     for name, (group, tp, data) in programs.items():
-        times = analytic_times(tp, machine, fir_fitted)
+        times = analytic_times(tp, machine, fir_fitted, planner_fitted)
         times["bilstm"] = predict_bilstm(bilstm, data)
         times["axis_nn"] = predict_axis_nn(axis_nns, data)
         for method, t in times.items():
