@@ -15,10 +15,12 @@ from nctwin.estimate.blend_planner import (
     OPTIMIZATION_DEPTH,
     STOP_TURN_RAD,
     blend_plane_acc,
+    blend_planner,
     junction_blends,
     move_limits,
     optimised_end_speeds,
     parabolic_junctions,
+    stops_on_periods,
     tangent_junctions,
 )
 from nctwin.gcode import parse
@@ -31,6 +33,15 @@ AXIS_ACC = np.array([1000.0, 1000.0, 500.0])
 
 def time_s(program: str) -> float:
     return estimate(parse(program, start_mm=(0, 0, 0)), MACHINE, "planner").cycle_time_s
+
+
+def estimate_planner(tp, **kwargs):
+    return blend_planner(tp, MACHINE, **kwargs)
+
+
+def whole_periods(t: float) -> float:
+    """A time from rest to rest on LinuxCNC: up to a whole number of 1 ms periods."""
+    return math.ceil(t / 0.001 - 1e-9) * 0.001
 
 
 def trapezoid_s(length: float, feed: float, acc: float, v0: float = 0.0, v1: float = 0.0) -> float:
@@ -61,7 +72,7 @@ def test_collinear_lines_run_at_full_acceleration_into_the_last_move():
     last = (peak - v1) / a2 + peak / a2
     program = "G21 G90 G64\nG1 X20 F12000\nX40\nX60\n"
     assert first_two + last == pytest.approx(0.616, abs=0.002)
-    assert time_s(program) == pytest.approx(first_two + last)
+    assert time_s(program) == pytest.approx(whole_periods(first_two + last))
 
 
 def test_corner_blend_arc():
@@ -79,13 +90,16 @@ def test_corner_blend_arc():
     )
     assert v == pytest.approx(14.46, abs=0.01)
     assert expected == pytest.approx(4.131, abs=0.002)
-    assert time_s("G21 G90 G64 P0.1\nG1 X100 F3000\nY100\n") == pytest.approx(expected)
+    corner = time_s("G21 G90 G64 P0.1\nG1 X100 F3000\nY100\n")
+    assert corner == pytest.approx(whole_periods(expected))
 
 
 def test_exact_stop_and_dwell_stop_the_tool():
     # G61: the corner is no tangent, so both lines stop at 0.9 a (tcSetKinkProperties):
-    # L/F + F/(0.9 a) each (LinuxCNC: 4.113 s)
-    assert time_s("G21 G90 G61\nG1 X100 F3000\nY100\n") == pytest.approx(2 * (2 + 50 / 900))
+    # L/F + F/(0.9 a) each, to a whole period (LinuxCNC: 4.112 s)
+    one = whole_periods(2 + 50 / 900)
+    assert one == pytest.approx(2.056)
+    assert time_s("G21 G90 G61\nG1 X100 F3000\nY100\n") == pytest.approx(2 * one)
     # G61.1: exact stop at the full acceleration
     assert time_s("G21 G90 G61.1\nG1 X100 F3000\nY100\n") == pytest.approx(2 * (2 + 0.05))
     # a dwell: the move before it keeps its parabolic end, so both lines brake at a / 2
@@ -96,13 +110,14 @@ def test_exact_stop_and_dwell_stop_the_tool():
 
 def test_a_turn_close_to_a_reversal_stops():
     # four 25.4 mm moves, each turning back within STOP_TURN_RAD / 4 of a half turn: each stops
-    # at its corner, the first three at the full acceleration, the last at a / 2
-    # (LinuxCNC, for turns within 0.002 rad: 1.519 s)
+    # at its corner, the first three at the full acceleration, the last at a / 2, each to a
+    # whole period (LinuxCNC, for turns within 0.002 rad: 1.519 s)
     y = 25.4 * math.tan(STOP_TURN_RAD / 8)
     program = f"G21 G90 G64\nG1 X25.4 F6000\nX0 Y{y:.6f}\nX25.4 Y{2 * y:.6f}\nX0 Y{3 * y:.6f}\n"
-    move = 25.4 / 100 + 100 / A  # L/F + F/a; the lengths differ from 25.4 mm by < 1 um
-    last = 25.4 / 100 + 100 / (A / 2)
-    assert time_s(program) == pytest.approx(3 * move + last, rel=1e-4)
+    length = parse(program, start_mm=(0, 0, 0)).lengths_mm  # 25.4 mm and < 1 um more
+    acc = np.array([A, A, A, A / 2])
+    expected = sum(whole_periods(t) for t in length / 100 + 100 / acc)  # L/F + F/a each
+    assert time_s(program) == pytest.approx(expected)
 
 
 def test_a_move_takes_at_least_one_period():
@@ -174,9 +189,11 @@ def test_a_rapid_and_a_feed_move_are_not_blended():
     # the tool stops between them (tpCheckCanonType): 10 mm rapid as a triangle at a,
     # 2 sqrt(L / a) = 0.2 s; then the last move from rest at a / 2: 2 sqrt(L / (a / 2)) = 0.283 s
     # (LinuxCNC: 0.483 s)
-    expected = 2 * math.sqrt(10 / A) + 2 * math.sqrt(10 / (A / 2))
-    assert time_s("G21 G90 G64\nG0 X10\nG1 X20 F6000\n") == pytest.approx(expected)
-    assert expected == pytest.approx(0.483, abs=0.001)
+    rapid, feed = 2 * math.sqrt(10 / A), 2 * math.sqrt(10 / (A / 2))
+    assert time_s("G21 G90 G64\nG0 X10\nG1 X20 F6000\n") == pytest.approx(
+        whole_periods(rapid) + whole_periods(feed)
+    )
+    assert whole_periods(rapid) + whole_periods(feed) == pytest.approx(0.483)
 
 
 def test_an_arc_is_one_move_under_its_centripetal_limit():
@@ -184,8 +201,8 @@ def test_an_arc_is_one_move_under_its_centripetal_limit():
     # mm/s, the tangential acceleration is a / 2; the arc is too short to reach it: a triangle
     # 2 sqrt(L / (a / 2)) with L = 5 pi (LinuxCNC: 0.355 s)
     expected = 2 * math.sqrt(5 * math.pi / (A / 2))
-    assert time_s("G21 G90 G61\nG2 X10 Y-10 I0 J-10 F6000\n") == pytest.approx(expected)
-    assert expected == pytest.approx(0.355, abs=0.001)
+    assert time_s("G21 G90 G61\nG2 X10 Y-10 I0 J-10 F6000\n") == pytest.approx(0.355)
+    assert whole_periods(expected) == pytest.approx(0.355)
 
 
 def test_naive_cam_merging_before_planning():
@@ -230,7 +247,9 @@ def test_tangent_junction_by_hand():
     # tangent: no stop, both lines at (1 - share) a; the last keeps its exact-path end (no a/2)
     a = A * (1 - share[0])
     total = trapezoid_s(10.0, 60.0, a, v1=60.0) + trapezoid_s(math.hypot(10, 0.01), 60.0, a, 60.0)
-    assert time_s("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n") == pytest.approx(total, rel=1e-3)
+    assert time_s("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n") == pytest.approx(
+        whole_periods(total), rel=1e-3
+    )
 
 
 def test_blend_arc_is_as_small_as_its_speed_allows():
@@ -255,3 +274,19 @@ def test_blend_arc_is_as_small_as_its_speed_allows():
             tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
         )[1]
         assert d[0] == pytest.approx(expected)
+
+
+def test_stops_fall_on_servo_periods():
+    # three items, a stop after the first: 0.2504 s from rest to rest -> 0.251; 0.1 + 0.3002 s
+    # -> 0.401, the rest of the period on the item that stops
+    t = stops_on_periods(np.array([0.2504, 0.1, 0.3002]), np.array([0.0, 50.0]), 0.001)
+    np.testing.assert_allclose(t, [0.251, 0.1, 0.301])
+    # LinuxCNC, three 7 mm moves at 37 mm/s under G61.1: 0.681 s (trapezoids: 0.6786 s)
+    program = "G21 G90 G61.1\nG1 X7 F2220\nY7\nX0\n"
+    assert 3 * (7 / 37 + 37 / A) == pytest.approx(0.6786, abs=1e-4)
+    assert time_s(program) == pytest.approx(3 * 0.227)
+    tp = parse(program, start_mm=(0, 0, 0))
+    mean = estimate_planner(tp, stop_periods="mean").cycle_time_s
+    assert mean == pytest.approx(3 * (7 / 37 + 37 / A + 0.0005))
+    with pytest.raises(ValueError, match="stop_periods = 'all' is not allowed: allowed whole"):
+        estimate_planner(tp, stop_periods="all")

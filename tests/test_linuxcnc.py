@@ -191,6 +191,13 @@ PLANNER_PROGRAMS = {
         for k in range(1, 21)
     )
     + "M2\n",
+    # G61 stops at each of 100 chords, each on a whole servo period (52 ms more than trapezoids)
+    "g61_circle": "G21 G90 G61\nG1 F3000\n"
+    + "".join(
+        f"X{5 * math.sin(k * math.pi / 50):.4f} Y{5 - 5 * math.cos(k * math.pi / 50):.4f}\n"
+        for k in range(1, 101)
+    )
+    + "M2\n",
     "g61_stops": "G21 G90 G61\nG1 F1800\n"
     + "".join(
         f"X{20 * math.sin(k / 20):.4f} Y{20 - 20 * math.cos(k / 20):.4f}\n" for k in range(1, 11)

@@ -173,8 +173,10 @@ def test_planner_ablation_by_hand():
     assert list(rows.rules) == list(rk.PLANNER_RULES)
     t = dict(zip(rows.rules, rows.predicted_s, strict=True))
     stop = 2 * (10 / 60 + 60 / 1000)  # two trapezoids from rest to rest (L/F + F/a)
-    assert t["no kinks"] == t["neither"] == pytest.approx(stop, rel=1e-5)
+    assert t["as first written"] == pytest.approx(stop, rel=1e-5)
+    assert t["no kinks"] == pytest.approx(2 * 0.227)  # each on a whole period
     assert t["all"] == t["largest arcs"] < stop - 0.05
+    assert t["stops off periods"] < t["all"]
     np.testing.assert_allclose(rows.err_pct, 100 * (rows.predicted_s - 1.0))
 
 
@@ -200,9 +202,11 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
         tp = parse(text, start_mm=(0, 0, 0))
         programs.append((tp, estimate(tp, truth, "planner").cycle_time_s))
     fit = rk.fit_planner(programs, MACHINE)
-    np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=1e-3)
-    np.testing.assert_allclose(fit.machine.axis_max_velocity_mm_s, (150, 180, 60), rtol=1e-3)
-    assert fit.max_err_pct < 1e-3
+    # the "recordings" stop on whole 1 ms periods, the fit plans half a period per stop: the
+    # limits come back within a few tenths of a percent
+    np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=5e-3)
+    np.testing.assert_allclose(fit.machine.axis_max_velocity_mm_s, (150, 180, 60), rtol=5e-3)
+    assert fit.max_err_pct < 0.5
     assert list(fit.limits.profile) == [1000, 1000, 500, 200, 200, 100]
 
 

@@ -449,7 +449,7 @@ class PlannerFit:
         One row per axis and limit: ``axis``, ``limit`` (``acceleration_mm_s2`` or
         ``velocity_mm_s``), ``start``, ``fitted``, ``profile`` (the value the profile had).
     mean_err_pct, max_err_pct : float
-        Mean and largest absolute cycle-time error (%) on the fitted programs.
+        Mean and largest absolute cycle-time error (%) of the fitted planner on the programs.
     evaluations : int
         Planner runs over the programs the fit took.
     """
@@ -474,7 +474,10 @@ def fit_planner(
     profile's values, by least squares on the log ratio of planned to recorded cycle time per
     program: scipy's trust-region reflective method on the logarithm of each limit, with
     finite differences of relative step 1e-3, from the generic ``start`` (every axis at the
-    same acceleration and velocity). The velocities are bounded by the profile's maximum feed
+    same acceleration and velocity). The fit plans each stop with half a servo period, not
+    with the tool at rest on a whole period (``stop_periods="mean"``): whole periods make the
+    planned time a step function of the limits, which finite differences cannot follow. The
+    velocities are bounded by the profile's maximum feed
     (``[TRAJ] MAX_LINEAR_VELOCITY``): an axis limit above the path's is never reached, and no
     recording can tell it. Everything else in the profile (maximum and rapid feed, servo period,
     default tolerance) is kept.
@@ -522,12 +525,15 @@ def fit_planner(
 
     def residual(x: np.ndarray) -> np.ndarray:
         m = profile(x)
-        planned = np.array([blend_planner(tp, m).cycle_time_s for tp, _ in programs])
+        planned = np.array(
+            [blend_planner(tp, m, stop_periods="mean").cycle_time_s for tp, _ in programs]
+        )
         return np.log(planned / measured)
 
     fit = least_squares(residual, x0, bounds=(lower, upper), diff_step=1e-3, method="trf")
     fitted = profile(fit.x)
-    err = 100 * np.abs(np.expm1(residual(fit.x)))
+    planned = np.array([blend_planner(tp, fitted).cycle_time_s for tp, _ in programs])
+    err = 100 * np.abs(planned / measured - 1)
     limits = pd.DataFrame(
         [{"axis": axis, "limit": limit, "start": s, "fitted": getattr(fitted, field)[i],
           "profile": getattr(machine, field)[i]}
@@ -624,20 +630,22 @@ def path_control(tp: Toolpath, machine: MachineProfile) -> str:
 
 #: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
 #: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
-#: before the CAM-style recordings showed the two rules missing.
+#: before the CAM-style recordings showed the rules for kinks and arcs missing, and before
+#: stops were put on whole servo periods.
 PLANNER_RULES = {
     "all": {},
     "no kinks": {"kinks": False},
     "largest arcs": {"sized_arcs": False},
-    "neither": {"kinks": False, "sized_arcs": False},
+    "stops off periods": {"stop_periods": "off"},
+    "as first written": {"kinks": False, "sized_arcs": False, "stop_periods": "off"},
 }
 
 
 def planner_ablation(
     programs: dict[str, tuple[str, Toolpath, float]], machine: MachineProfile
 ) -> pd.DataFrame:
-    """The blend-arc planner with and without its rules for nearly tangent junctions and for
-    the size of blend arcs (:data:`PLANNER_RULES`).
+    """The blend-arc planner with and without its rules for nearly tangent junctions, for the
+    size of blend arcs and for stops on whole servo periods (:data:`PLANNER_RULES`).
 
     The planner learns nothing from recordings, so for it the training sets are held-out
     programs: a check of its rules on programs that were not used to find them.

@@ -70,41 +70,45 @@ Item time: the trapezoid (or triangle) from :math:`v_j` to :math:`v_{j+1}` under
 
 Measured on LinuxCNC (``linuxcnc_sim``, recorded live; model in brackets): one 60 mm line at
 50 mm/s in the default ``G64``: 1.301 s (1.300); a 90° corner of two 100 mm lines at 50 mm/s,
-``G64 P0.1``: 4.131 s (4.130), with a 0.5 s dwell instead of the blend: 4.704 s (4.700), under
-``G61``: 4.113 s (4.111); six 10 mm lines with 90° corners at 100 mm/s, ``G64 P0.1``: 1.244 s
-(1.242); 120° and 90° corners at 150 mm/s, ``G64 P0.5``: 1.082 s (1.080); four 25.4 mm moves
-that turn back within 0.002 rad, plain ``G64``: 1.519 s (1.516); collinear chains at 200 mm/s,
-plain ``G64``: 300 x 1 mm 1.740 s (1.739), 10 x 5 mm 0.528 s (0.526), 3 x 20 mm 0.616 s
-(0.615), 300 x 0.2 mm 0.583 s (0.582, held at 142 mm/s by the depth), 300 x 0.05 mm 0.364 s
+``G64 P0.1``: 4.131 s (4.130), with a 0.5 s dwell instead of the blend: 4.702-4.704 s (4.700),
+under ``G61``: 4.112 s (4.112); six 10 mm lines with 90° corners at 100 mm/s, ``G64 P0.1``:
+1.244 s (1.243); 120° and 90° corners at 150 mm/s, ``G64 P0.5``: 1.082 s (1.080); four 25.4 mm moves
+that turn back within 0.002 rad, plain ``G64``: 1.519 s (1.519); collinear chains at 200 mm/s,
+plain ``G64``: 300 x 1 mm 1.740 s (1.739), 10 x 5 mm 0.528 s (0.527), 3 x 20 mm 0.616 s
+(0.615), 300 x 0.2 mm 0.583 s (0.583, held at 142 mm/s by the depth), 300 x 0.05 mm 0.364 s
 (0.364, held at 49 mm/s by the item length); zigzags of 45° moves, 20 x 5 mm in XY at
-``G64 P0.5``: 2.237 s (2.237), 20 x 1 mm in XZ: 1.109 s (1.108); a rapid then a feed move:
+``G64 P0.5``: 2.237 s (2.237), 20 x 1 mm in XZ: 1.109 s (1.109); a rapid then a feed move:
 0.483 s (0.483); a G2 quarter circle of 10 mm radius under ``G61``: 0.355 s (0.355); 79 moves
-of 0.4 mm round a 20 mm corner at 92 mm/s, ``G64 P0.3``, then a 40 mm line: 1.497 s (1.496, the
+of 0.4 mm round a 20 mm corner at 92 mm/s, ``G64 P0.3``, then a 40 mm line: 1.497 s (1.497, the
 lazy look-ahead's dip to 50 mm/s); a line along Y into a G18 arc: 1.806 s (1.799). Naive-CAM
 merging: 300 moves of 0.01-0.1 mm with 2° turns under ``G64 P0.01`` 0.407 s (0.412); the
 public programs Cereal, Pasta and wheels, whose lines LinuxCNC reports are exactly those of the
 merged moves. The model misses two collinear lines (1.301 s, model 1.275: LinuxCNC runs the
 first at :math:`a/2` too) and 200 moves wiggling 0.004 mm about a line under ``G64 P0.01``,
 merged into two lines (0.254 s, model 0.273). The live tests of :mod:`nctwin.kernel.linuxcnc`
-check eight of these programs.
+check eight of these programs. Some model values here date from before stops were put on
+whole servo periods (below), which adds less than 1 ms to a program that stops only at its end.
 
 Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits,
 the size limits of its blends between a line and an arc or two arcs (here the line-line formula
 on the tangents), the speed limit of a junction that is not tangent but whose blend arc fails,
-a stop's extra servo periods, and helical arcs' effective radius.
+the time LinuxCNC's task takes around a dwell (2-4 ms), and helical arcs' effective radius.
 Three rules were added after the CAM-style recordings (:mod:`nctwin.programs.camstyle`) had
 shown the model wrong by up to 59 % (``G61`` 3D rasters, stopped at every 0.3 mm step where
 LinuxCNC passes them as tangent) and 20 % (slow reversals on a plain ``G64``, whose arcs were
 taken as large as the tolerance allows): the tangent junctions, the blend arc sized for its
 speed, and ``G61``'s reduced acceleration, each read in LinuxCNC's source and checked live:
-``G61``, 20 chords of 1 mm on a 500 mm radius at 30 mm/s (tangent): 0.699 s (0.701); 10
-chords of 1 mm on a 20 mm radius (stops): 0.657 s (0.653); 100 chords of 0.3 mm on 50 mm at
-60 mm/s: 3.594 s (3.541; ``G61.1`` on 500 mm: 3.500 s, 3.463: LinuxCNC takes about 0.4 ms
-more per stop than a trapezoid); 10 mm circles of 20, 100 and 400 chords at 50 mm/s: 2.512,
-5.308 and 10.488 s (2.499, 5.262 and 10.271: the same per-stop time); plain
+``G61``, 20 chords of 1 mm on a 500 mm radius at 30 mm/s (tangent): 0.699 s (0.702); 10
+chords of 1 mm on a 20 mm radius (stops): 0.657 s (0.657); plain
 ``G64``, six 10 mm moves turning by 140 degrees at 20 mm/s: 2.673 s (2.673), by 160 degrees
 at 6 mm/s: 9.713 s (9.713), by 170 degrees at 60 mm/s: 1.070 s (1.070); 20 mm moves turning
 by 60 degrees at 30 mm/s: 5.332 s (5.331, 4.940 with the largest arcs).
+A fourth rule came from the ``G61`` programs the planner still underestimated, by about half a
+servo period per stop: the tool comes to rest on a whole servo period (:func:`stops_on_periods`,
+``tpCheckEndCondition``). Checked live under ``G61``: 100 chords of 0.3 mm on a 50 mm radius
+at 60 mm/s: 3.594 s (3.594; 3.541 as trapezoids); circles of 5 mm radius in 20, 100 and 400
+chords at 50 mm/s: 1.580, 3.592 and 7.272 s (1.580, 3.592 and 7.272; 1.573, 3.540 and 7.082 as
+trapezoids); under ``G61.1``, the 0.3 mm chords on a 500 mm radius: 3.500 s (3.500; 3.463).
 """
 
 from __future__ import annotations
@@ -123,6 +127,7 @@ from .result import Estimate
 __all__ = [
     "KINK_RATIO",
     "NORMAL_ACC_RATIO",
+    "STOP_PERIODS",
     "STOP_TURN_RAD",
     "TANGENTIAL_ACC_RATIO",
     "TOLERANCE_RATIO",
@@ -151,6 +156,8 @@ GAP_CYCLES = 4
 #: A junction whose kink needs less than this share of an axis's acceleration is passed as
 #: tangent, without a blend arc or a stop (``ARC_BLEND_TANGENT_KINK_RATIO``, default 0.1).
 KINK_RATIO = 0.1
+#: What a stop costs beyond its trapezoids (:func:`blend_planner`'s ``stop_periods``).
+STOP_PERIODS = ("whole", "mean", "off")
 
 
 def move_limits(
@@ -435,6 +442,37 @@ def segment_times(
     return np.where(length_mm > 0, t, 0.0)
 
 
+def stops_on_periods(t_s: np.ndarray, v_mm_s: np.ndarray, period_s: float) -> np.ndarray:
+    """Item times with the tool coming to rest on a servo period.
+
+    LinuxCNC splits the last cycle of a segment between it and the next only where the motion
+    goes on (``tpCheckEndCondition`` returns early for a segment that ends in a stop, which is
+    removed once its distance to go is within ``TP_POS_EPSILON``), so a stop falls on a cycle
+    and the time from rest to rest is a whole number of periods. Measured on LinuxCNC: three
+    7 mm moves at 37 mm/s under ``G61.1`` take 0.681 s (trapezoids: 0.6786 s), 40 chords of
+    0.3 mm at 60 mm/s 1.400 s (1.379 s).
+
+    Parameters
+    ----------
+    t_s : ndarray, shape (S,)
+        Times of the items (continuous, :func:`segment_times`).
+    v_mm_s : ndarray, shape (S - 1,)
+        Speed limits at the junctions; 0 is a stop (the ends of the queue are stops).
+    period_s : float
+
+    Returns
+    -------
+    ndarray, shape (S,)
+        ``t_s`` with the rest of each stop's last period added to the item that stops.
+    """
+    stops = np.flatnonzero(np.concatenate([[0.0], v_mm_s, [0.0]]) == 0)
+    run = np.add.reduceat(t_s, stops[:-1])  # rest to rest; every item has a positive length
+    whole = np.ceil(run / period_s - 1e-9) * period_s
+    out = t_s.copy()
+    out[stops[1:] - 1] += whole - run
+    return out
+
+
 @njit(cache=True)
 def _optimise(q_len, q_acc, q_max, blended, last_item, new_len, new_acc, new_max, depth, cutoff):
     """Compiled body of :func:`optimised_end_speeds` (same arguments)."""  # pragma: no cover
@@ -523,7 +561,12 @@ def optimised_end_speeds(
 
 
 def blend_planner(
-    toolpath: Toolpath, machine: MachineProfile, *, kinks: bool = True, sized_arcs: bool = True
+    toolpath: Toolpath,
+    machine: MachineProfile,
+    *,
+    kinks: bool = True,
+    sized_arcs: bool = True,
+    stop_periods: str = "whole",
 ) -> Estimate:
     """Cycle time on the blend-arc look-ahead planner (see the module docstring).
 
@@ -537,6 +580,11 @@ def blend_planner(
         LinuxCNC's rules for nearly tangent junctions and G61's reduced acceleration
         (:func:`tangent_junctions`), and for the size of blend arcs (:func:`junction_blends`);
         both on by default, off only for the ablation that shows what each is worth.
+    stop_periods : {"whole", "mean", "off"}
+        ``whole``: the tool comes to rest on a servo period (:func:`stops_on_periods`), as on
+        LinuxCNC; ``mean``: each stop adds half a period instead, the mean of the same on
+        average and a smooth function of the machine's limits (for fitting them, where whole
+        periods make the cycle time a step function); ``off``: no time for it (the ablation).
 
     Returns
     -------
@@ -544,6 +592,10 @@ def blend_planner(
         ``method="planner"``, per-block times of shape (N,) (a dwell its own time; a blend arc's
         time is shared by the two moves it joins).
     """
+    if stop_periods not in STOP_PERIODS:
+        raise ValueError(
+            f"stop_periods = {stop_periods!r} is not allowed: allowed {', '.join(STOP_PERIODS)}"
+        )
     merged, merged_source = merge_naive_cam(toolpath)
     source = np.flatnonzero((merged.kind != MotionKind.DWELL) & (merged.lengths_mm > 0))
     if not len(source):
@@ -651,6 +703,10 @@ def blend_planner(
     limit = np.minimum(limit[:-1], np.minimum(q_feed[:-1], q_feed[1:]))
     t = np.zeros(2 * m - 1)
     t[keep] = segment_times(q_len, q_feed, q_acc, limit)
+    if stop_periods == "whole":
+        t[keep] = stops_on_periods(t[keep], limit, machine.period_s)
+    elif stop_periods == "mean":
+        t[keep] += np.append(limit == 0, True) * (0.5 * machine.period_s)
     move_t = t[0::2] + np.concatenate([[0.0], t[1::2] / 2]) + np.concatenate([t[1::2] / 2, [0.0]])
     block_t = np.bincount(merged_source[source], weights=move_t, minlength=len(toolpath))
     block_t += toolpath.dwell_s
