@@ -191,6 +191,10 @@ PLANNER_PROGRAMS = {
         for k in range(1, 21)
     )
     + "M2\n",
+    # a turn 0.03 rad short of a reversal: within tpSetupTangent's 2 degrees, a stop
+    "sharp_reversal": "G21 G90 G64\nG1 X13.654 F774\n"
+    + f"X{13.654 - 33.302 * math.cos(0.03):.4f} Y{33.302 * math.sin(0.03):.4f}\n"
+    + f"X{23.654 - 33.302 * math.cos(0.03):.4f}\nM2\n",
     # G61 stops at each of 100 chords, each on a whole servo period (52 ms more than trapezoids)
     "g61_circle": "G21 G90 G61\nG1 F3000\n"
     + "".join(

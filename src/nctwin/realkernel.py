@@ -630,14 +630,19 @@ def path_control(tp: Toolpath, machine: MachineProfile) -> str:
 
 #: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
 #: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
-#: before the CAM-style recordings showed the rules for kinks and arcs missing, and before
-#: stops were put on whole servo periods.
+#: before the CAM-style recordings showed the rules for kinks and arcs missing, before stops
+#: were put on whole servo periods, and with the near-reversal threshold it had then measured.
 PLANNER_RULES = {
     "all": {},
     "no kinks": {"kinks": False},
     "largest arcs": {"sized_arcs": False},
     "stops off periods": {"stop_periods": "off"},
-    "as first written": {"kinks": False, "sized_arcs": False, "stop_periods": "off"},
+    "as first written": {
+        "kinks": False,
+        "sized_arcs": False,
+        "stop_periods": "off",
+        "stop_turn_rad": 0.02,
+    },
 }
 
 
