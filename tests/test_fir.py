@@ -81,19 +81,6 @@ def test_filter_is_the_convolution_with_its_weights(t2_s):
     np.testing.assert_allclose(out, expected, rtol=0, atol=1e-9)
 
 
-def test_range_min_matches_brute_force():
-    rng = np.random.default_rng(1)
-    for _ in range(200):
-        n = int(rng.integers(1, 80))
-        lo = rng.integers(0, n, 12)
-        hi = np.minimum(lo + rng.integers(0, n + 1, 12), n)
-        value = rng.uniform(0, 1, 12)
-        expected = np.full(n, np.inf)
-        for a, b, v in zip(lo, hi, value, strict=True):
-            expected[a:b] = np.minimum(expected[a:b], v)
-        np.testing.assert_array_equal(fir._range_min(n, lo, hi, value), expected)
-
-
 def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0

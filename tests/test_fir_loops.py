@@ -98,3 +98,16 @@ def test_limit_ratios_equal_numpy_differences(seed, n, mask):
     ratio = np.empty(n)
     _fir_loops.limit_ratios(vel, PERIOD_S, limits, over, ratio)
     np.testing.assert_array_equal(ratio, _numpy_limit_ratios(vel, limits, over))
+
+
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 80), ranges=st.integers(0, 30))
+def test_range_min_equals_brute_force(seed, n, ranges):
+    rng = np.random.default_rng(seed)
+    lo = rng.integers(0, n, ranges)
+    hi = np.clip(lo + rng.integers(-2, n + 1, ranges), 0, n)  # some empty, hi <= lo
+    value = rng.choice(rng.uniform(0, 1, 5), ranges)  # ties among the values
+    expected = np.full(n, np.inf)
+    for a, b, v in zip(lo, hi, value, strict=True):
+        expected[a:b] = np.minimum(expected[a:b], v)
+    np.testing.assert_array_equal(_fir_loops.range_min(n, lo, hi, value), expected)

@@ -1,5 +1,6 @@
 """Compiled sample loops of the FIR kernel (numba): sampling the command, the box cascade and the
-axis-limit extremes, one pass over the samples each.
+axis-limit extremes, one pass over the samples each; and the minimum over covering ranges that
+lowers the speed command.
 
 Each loop performs the same floating-point operations, in the same order, as the numpy code it
 replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``), so the kernel's output
@@ -12,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["box_cascade", "derivative_peaks", "limit_ratios", "sample_command"]
+__all__ = ["box_cascade", "derivative_peaks", "limit_ratios", "range_min", "sample_command"]
 
 
 @njit(cache=True)
@@ -149,3 +150,28 @@ def limit_ratios(vel, period_s, limits, over, ratio):  # pragma: no cover - comp
                 if i >= 3 and over[2, a]:
                     ratio[i] = max(ratio[i], abs((acc - acc_prev) / period_s) / limits[2, a])
                 acc_prev = acc
+
+
+@njit(cache=True)
+def range_min(n, lo, hi, value):  # pragma: no cover - compiled
+    """For each of ``n`` cells, the minimum ``value`` of the ranges ``[lo, hi)`` covering it.
+
+    ``lo``, ``hi`` (R,) integers with ``0 <= lo`` and ``hi <= n`` (empty ranges, ``hi <= lo``,
+    cover nothing), ``value`` (R,) not NaN; returns (n,), ``inf`` where no range covers the
+    cell. The ranges paint the cells no lower value has painted, lowest value first;
+    ``skip[c]`` leads from a painted cell towards the next unpainted one (union-find, paths
+    shortened as they are walked): O(R log R) for the order, O(n + R) for the painting.
+    """
+    out = np.full(n, np.inf)
+    skip = np.arange(n + 1)  # skip[c] == c: cell c unpainted (n: the end)
+    for r in np.argsort(value, kind="mergesort"):
+        c = lo[r]
+        while c < hi[r]:
+            if skip[c] != c:  # painted: jump on, halving the path
+                skip[c] = skip[skip[c]]
+                c = skip[c]
+            else:
+                out[c] = value[r]
+                skip[c] = hi[r]  # every cell up to hi[r] is painted once this range is done
+                c += 1
+    return out

@@ -323,31 +323,6 @@ def plan(
     return Plan(feed, v, pause)
 
 
-def _range_min(n: int, lo: np.ndarray, hi: np.ndarray, value: np.ndarray) -> np.ndarray:
-    """For each of ``n`` cells, the minimum ``value`` of the ranges ``[lo, hi)`` covering it
-    (``inf`` where none does). O((n + ranges) log n), without a Python loop over ranges."""
-    out = np.full(n, np.inf)
-    if n == 0 or len(lo) == 0:
-        return out
-    length = hi - lo
-    keep = length > 0
-    lo, hi, value, length = lo[keep], hi[keep], value[keep], length[keep]
-    k = np.floor(np.log2(np.maximum(length, 1))).astype(np.int64)
-    levels = int(k.max()) + 1 if len(k) else 1  # no table above the longest range's level
-    tables = [np.full(n, np.inf) for _ in range(levels)]
-    # each range is the union of two blocks of size 2**k: [lo, lo+2**k) and [hi-2**k, hi)
-    for level in np.unique(k):
-        m = k == level
-        np.minimum.at(tables[level], lo[m], value[m])
-        np.minimum.at(tables[level], hi[m] - (1 << int(level)), value[m])
-    for level in range(levels - 1, 0, -1):  # push blocks of 2**level down to halves
-        half = 1 << (level - 1)
-        t, below = tables[level], tables[level - 1]
-        np.minimum(below, t, out=below)
-        np.minimum(below[half:], t[:-half] if half < n else t[:0], out=below[half:])
-    return tables[0]
-
-
 @dataclass(frozen=True)
 class _Command:
     """Piecewise-constant speed command along the path.
@@ -401,7 +376,7 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Comma
     if zone.any():
         i_lo = np.searchsorted(cuts, z_lo)
         i_hi = np.searchsorted(cuts, z_hi)
-        speed = np.minimum(speed, _range_min(len(mid), i_lo, i_hi, v[zone]))
+        speed = np.minimum(speed, _fir_loops.range_min(len(mid), i_lo, i_hi, v[zone]))
     at = np.searchsorted(cuts, s_start)
     pause = np.zeros(len(cuts))
     np.add.at(pause, at, p.pause_s)
@@ -574,7 +549,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         move_t0 = t_knots[1::2][:-1]  # start times of the moving intervals
         i_lo = np.searchsorted(move_t0, t_lo, side="right") - 1
         i_hi = np.searchsorted(move_t0, t_hi, side="right")
-        factor = _range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
+        factor = _fir_loops.range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
         slow = factor < 1.0
         scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
     t = np.arange(len(pos)) * ts
