@@ -37,6 +37,11 @@ def test_box_cascade_equals_numpy_running_sums(seed, m, taps):
     out_t = np.empty_like(out)
     _fir_loops.box_cascade(np.ascontiguousarray(x.T).T, np.array(taps, dtype=np.int64), out_t)
     np.testing.assert_array_equal(out_t, out)
+    # and so does the input in the first rows of the output, filtered in place
+    out_in_place = np.empty_like(out)
+    out_in_place[:m] = x
+    _fir_loops.box_cascade(out_in_place[:m], np.array(taps, dtype=np.int64), out_in_place)
+    np.testing.assert_array_equal(out_in_place, out)
 
 
 @settings(max_examples=60, deadline=None)
@@ -58,28 +63,34 @@ def test_sample_command_equals_np_interp(seed, k, pauses):
     np.testing.assert_array_equal(out, expected)
 
 
-@settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300))
+def _numpy_derivatives(pos: np.ndarray) -> list[np.ndarray]:
+    """Velocity from sample 1 on, acceleration from 2, jerk from 3: numpy's differences."""
+    derivs = [(pos[1:] - pos[:-1]) / PERIOD_S]
+    for _ in range(2):
+        derivs.append(np.diff(derivs[-1], axis=0) / PERIOD_S)
+    return derivs
+
+
+#: Sample counts across several chunks of the derivative loops, and their edges.
+SAMPLES = st.one_of(
+    st.integers(1, 40), st.integers(1, 4 * _fir_loops.CHUNK + 5), st.sampled_from([513, 514, 515])
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=SAMPLES)
 def test_derivative_peaks_equal_numpy_differences(seed, n):
     rng = np.random.default_rng(seed)
     pos = np.cumsum(rng.normal(size=(n, 3)), axis=0)
-    vel = np.empty_like(pos)
-    peak = _fir_loops.derivative_peaks(pos, PERIOD_S, vel)
-    expected_vel = np.zeros_like(pos)
-    expected_vel[1:] = (pos[1:] - pos[:-1]) / PERIOD_S
-    np.testing.assert_array_equal(vel, expected_vel)
-    acc = np.diff(expected_vel[1:], axis=0) / PERIOD_S
-    jerk = np.diff(acc, axis=0) / PERIOD_S
-    for order, d in enumerate([expected_vel[1:], acc, jerk]):
+    peak = _fir_loops.derivative_peaks(pos, PERIOD_S)
+    for order, d in enumerate(_numpy_derivatives(pos)):
         np.testing.assert_array_equal(peak[order], np.abs(d).max(axis=0, initial=0.0))
 
 
-def _numpy_limit_ratios(vel, limits, over):
+def _numpy_limit_ratios(pos, limits, over):
     """The ratios with numpy's differences, as the kernel computed them before the loop."""
-    derivs = [vel[1:]]
-    for _ in range(2):
-        derivs.append(np.diff(derivs[-1], axis=0) / PERIOD_S)
-    ratio = np.zeros(len(vel))
+    derivs = _numpy_derivatives(pos)
+    ratio = np.zeros(len(pos))
     for order, a in np.argwhere(over):
         r = np.abs(derivs[order][:, a]) / limits[order, a]
         np.maximum(ratio[order + 1 :], r, out=ratio[order + 1 :])
@@ -87,17 +98,15 @@ def _numpy_limit_ratios(vel, limits, over):
 
 
 @settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300), mask=st.integers(0, 511))
+@given(seed=st.integers(0, 2**32 - 1), n=SAMPLES, mask=st.integers(0, 511))
 def test_limit_ratios_equal_numpy_differences(seed, n, mask):
     rng = np.random.default_rng(seed)
     pos = np.cumsum(rng.normal(size=(n, 3)), axis=0)
-    vel = np.empty_like(pos)
-    _fir_loops.derivative_peaks(pos, PERIOD_S, vel)
     limits = rng.uniform(0.5, 2.0, (3, 3)) * np.array([[1e3], [1e6], [1e9]])
     over = (mask >> np.arange(9)).reshape(3, 3) % 2 == 1
     ratio = np.empty(n)
-    _fir_loops.limit_ratios(vel, PERIOD_S, limits, over, ratio)
-    np.testing.assert_array_equal(ratio, _numpy_limit_ratios(vel, limits, over))
+    _fir_loops.limit_ratios(pos, PERIOD_S, limits, over, ratio)
+    np.testing.assert_array_equal(ratio, _numpy_limit_ratios(pos, limits, over))
 
 
 @settings(max_examples=100, deadline=None)

@@ -23,10 +23,13 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
     ``t_knots`` (K,) non-decreasing from 0, ``x_knots`` (K, 3); writes ``out`` (n_cmd, 3). The same
     arithmetic as ``np.interp`` per axis (value at a knot exactly, ``slope * (t - t_j) + x_j``
     inside, the last value at and after the last knot); the knot search walks forward, as the
-    sample times increase.
+    sample times increase, and the slopes of a segment are computed once, when a sample first
+    falls inside it.
     """
     k = len(t_knots)
     j = 0
+    sloped = -1  # the segment whose slopes ``slope`` holds
+    slope = np.empty(3)
     for i in range(n_cmd):
         t = i * period_s
         while j + 1 < k and t_knots[j + 1] <= t:
@@ -38,12 +41,15 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
             for a in range(3):
                 out[i, a] = x_knots[j, a]
         else:
-            dt = t_knots[j + 1] - t_knots[j]
+            if sloped != j:
+                dt = t_knots[j + 1] - t_knots[j]
+                for a in range(3):
+                    slope[a] = (x_knots[j + 1, a] - x_knots[j, a]) / dt
+                sloped = j
             for a in range(3):
-                slope = (x_knots[j + 1, a] - x_knots[j, a]) / dt
-                v = slope * (t - t_knots[j]) + x_knots[j, a]
+                v = slope[a] * (t - t_knots[j]) + x_knots[j, a]
                 if np.isnan(v):
-                    v = slope * (t - t_knots[j + 1]) + x_knots[j + 1, a]
+                    v = slope[a] * (t - t_knots[j + 1]) + x_knots[j + 1, a]
                     if np.isnan(v) and x_knots[j, a] == x_knots[j + 1, a]:
                         v = x_knots[j, a]
                 out[i, a] = v
@@ -55,9 +61,9 @@ def box_cascade(x, taps, out):  # pragma: no cover - compiled
     at its last value past its end, as :meth:`nctwin.kernel.fir.FirFilter.apply`: running sums
     of the positions relative to the first, differenced ``n`` apart, over ``n``.
 
-    ``x`` may be any 2-D view; ``out`` is (m + sum(taps) - len(taps), 3). Each stage runs in
-    place in ``out``; the last ``n`` running sums are kept in a ring, so no other buffer of
-    the signal's size is made.
+    ``x`` may be any 2-D view, ``out[:m]`` itself included; ``out`` is
+    (m + sum(taps) - len(taps), 3). Each stage runs in place in ``out``; the last ``n`` running
+    sums are kept in a ring, so no other buffer of the signal's size is made.
     """
     m = x.shape[0]
     ring = np.empty((taps.max(), 3))
@@ -90,66 +96,103 @@ def box_cascade(x, taps, out):  # pragma: no cover - compiled
             out[i, a] += x0[a]
 
 
-@njit(cache=True)
-def derivative_peaks(pos, period_s, vel):  # pragma: no cover - compiled
-    """Axis velocities and the largest magnitude of velocity, acceleration and jerk per axis.
+#: Samples per chunk of the derivative loops (their buffers stay in the first-level cache).
+CHUNK = 512
 
-    ``pos`` (n, 3); writes ``vel`` (n, 3), backward differences with ``vel[0] = 0``; returns
-    (3, 3): row = derivative order (velocity from sample 1 on, acceleration, jerk as
-    successive backward differences over the period), column = axis. One pass per axis, the
-    previous velocity and acceleration carried along.
+
+@njit(cache=True)
+def _chunk_derivatives(flat, r0, r1, period_s, vel, acc):  # pragma: no cover - compiled
+    """Velocities and accelerations of samples ``r0 <= i < r1`` (``1 <= r0 < r1``) of the
+    positions ``flat`` (3 n,), sample-major: backward differences over the period.
+
+    Writes ``vel[3:]`` and ``acc[3:]``, (3 (r1 - r0),) axis fastest, accelerations from sample 2
+    on; ``vel[:3]`` and ``acc[:3]`` hold sample ``r0 - 1``'s (the caller carries them from the
+    previous chunk). Loops over contiguous slices without branches: LLVM vectorises them,
+    divisions included.
+    """
+    m = 3 * (r1 - r0)
+    now, before, v = flat[3 * r0 : 3 * r1], flat[3 * r0 - 3 : 3 * r1 - 3], vel[3 : 3 + m]
+    for k in range(m):
+        v[k] = (now[k] - before[k]) / period_s
+    skip = 3 * (max(r0, 2) - r0)  # sample 1 has no acceleration
+    a, v_now, v_before = acc[3 + skip : 3 + m], vel[3 + skip : 3 + m], vel[skip:m]
+    for k in range(m - skip):
+        a[k] = (v_now[k] - v_before[k]) / period_s
+
+
+@njit(cache=True)
+def derivative_peaks(pos, period_s):  # pragma: no cover - compiled
+    """Largest magnitude of velocity, acceleration and jerk per axis of ``pos`` (n, 3),
+    C-contiguous.
+
+    Returns (3, 3): row = derivative order (velocity from sample 1 on, acceleration from 2, jerk
+    from 3, successive backward differences over the period), column = axis. By chunks of
+    :data:`CHUNK` samples (:func:`_chunk_derivatives`), the three orders of an axis in one loop.
+    The jerk's peak is the largest difference of accelerations divided once by the period:
+    division by a positive number rounds monotonically, so this is the largest of the divided
+    differences, bit for bit.
     """
     n = pos.shape[0]
+    flat = pos.reshape(-1)
+    vel = np.empty(3 * CHUNK + 3)
+    acc = np.empty(3 * CHUNK + 3)
     peak = np.zeros((3, 3))
+    for r0 in range(1, n, CHUNK):
+        r1 = min(r0 + CHUNK, n)
+        _chunk_derivatives(flat, r0, r1, period_s, vel, acc)
+        if r0 == 1:
+            # sample 1 has no acceleration, samples 1 and 2 no jerk: sample 2's acceleration
+            # (0 without it) in their place, and before them, adds nothing to the peaks
+            for a in range(3):
+                acc[a] = acc[3 + a] = acc[6 + a] if r1 > 2 else 0.0
+        end = 3 * (r1 - r0) + 3
+        for a in range(3):
+            top_v, top_acc, top_dacc = peak[0, a], peak[1, a], peak[2, a]
+            for k in range(3 + a, end, 3):
+                top_v = max(top_v, abs(vel[k]))
+                top_acc = max(top_acc, abs(acc[k]))
+                top_dacc = max(top_dacc, abs(acc[k] - acc[k - 3]))
+            peak[0, a], peak[1, a], peak[2, a] = top_v, top_acc, top_dacc
+        vel[:3] = vel[end - 3 : end]
+        acc[:3] = acc[end - 3 : end]
     for a in range(3):
-        vel[0, a] = 0.0
-        v_prev = 0.0
-        acc_prev = 0.0
-        top_v = 0.0
-        top_acc = 0.0
-        top_jerk = 0.0
-        for i in range(1, n):
-            v = (pos[i, a] - pos[i - 1, a]) / period_s
-            vel[i, a] = v
-            top_v = max(top_v, abs(v))
-            if i >= 2:
-                acc = (v - v_prev) / period_s
-                top_acc = max(top_acc, abs(acc))
-                if i >= 3:
-                    top_jerk = max(top_jerk, abs((acc - acc_prev) / period_s))
-                acc_prev = acc
-            v_prev = v
-        peak[0, a] = top_v
-        peak[1, a] = top_acc
-        peak[2, a] = top_jerk
+        peak[2, a] /= period_s
     return peak
 
 
 @njit(cache=True)
-def limit_ratios(vel, period_s, limits, over, ratio):  # pragma: no cover - compiled
-    """Per sample, the largest ratio of an axis derivative to its limit, over the (order, axis)
-    pairs that ``over`` (3, 3) marks.
+def limit_ratios(pos, period_s, limits, over, ratio):  # pragma: no cover - compiled
+    """Per sample, the largest ratio of an axis derivative of ``pos`` (n, 3), C-contiguous, to
+    its limit, over the (order, axis) pairs that ``over`` (3, 3) marks.
 
-    ``vel`` (n, 3) as :func:`derivative_peaks` writes it; ``limits`` (3, 3) as its peaks (row =
-    order, column = axis); writes ``ratio`` (n,): the derivative of order ``k`` (0 velocity, 1
-    acceleration, 2 jerk) counts at sample ``i`` from ``i = k + 1`` on, 0 where none counts.
-    The same differences as :func:`derivative_peaks` (and ``np.diff`` over the period).
+    ``limits`` (3, 3) as the peaks of :func:`derivative_peaks` (row = order, column = axis);
+    writes ``ratio`` (n,): the derivative of order ``k`` (0 velocity, 1 acceleration, 2 jerk)
+    counts at sample ``i`` from ``i = k + 1`` on, 0 where none counts. The same differences as
+    :func:`derivative_peaks` (and ``np.diff`` over the period), by chunks.
     """
-    n = vel.shape[0]
-    for i in range(n):
-        ratio[i] = 0.0
-    for a in range(3):
-        acc_prev = 0.0
-        for i in range(1, n):
-            if over[0, a]:
-                ratio[i] = max(ratio[i], abs(vel[i, a]) / limits[0, a])
-            if i >= 2:
-                acc = (vel[i, a] - vel[i - 1, a]) / period_s
-                if over[1, a]:
-                    ratio[i] = max(ratio[i], abs(acc) / limits[1, a])
+    n = pos.shape[0]
+    flat = pos.reshape(-1)
+    vel = np.empty(3 * CHUNK + 3)
+    acc = np.empty(3 * CHUNK + 3)
+    ratio[:1] = 0.0
+    for r0 in range(1, n, CHUNK):
+        r1 = min(r0 + CHUNK, n)
+        _chunk_derivatives(flat, r0, r1, period_s, vel, acc)
+        for i in range(r0, r1):
+            k = 3 * (i - r0) + 3
+            top = 0.0
+            for a in range(3):
+                if over[0, a]:
+                    top = max(top, abs(vel[k + a]) / limits[0, a])
+                if i >= 2 and over[1, a]:
+                    top = max(top, abs(acc[k + a]) / limits[1, a])
                 if i >= 3 and over[2, a]:
-                    ratio[i] = max(ratio[i], abs((acc - acc_prev) / period_s) / limits[2, a])
-                acc_prev = acc
+                    jerk = (acc[k + a] - acc[k + a - 3]) / period_s
+                    top = max(top, abs(jerk) / limits[2, a])
+            ratio[i] = top
+        end = 3 * (r1 - r0) + 3
+        vel[:3] = vel[end - 3 : end]
+        acc[:3] = acc[end - 3 : end]
 
 
 @njit(cache=True)

@@ -122,10 +122,12 @@ class FirFilter:
         """
         return self._apply_rows(x.T).T
 
-    def _apply_rows(self, x: np.ndarray) -> np.ndarray:
-        """:meth:`apply` on sample-major positions, (n, 3), to (n', 3) C-contiguous."""
+    def _apply_rows(self, x: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`apply` on sample-major positions, (n, 3), to (n', 3) C-contiguous: into
+        ``out`` if given, of which ``x`` may be the first n rows (filtered in place)."""
         taps = np.array([n for n in self.taps if n > 1], dtype=np.int64)
-        out = np.empty((len(x) + int(taps.sum()) - len(taps), 3))
+        if out is None:
+            out = np.empty((len(x) + int(taps.sum()) - len(taps), 3))
         _fir_loops.box_cascade(x, taps, out)
         return out
 
@@ -457,34 +459,42 @@ def _interpolate(tp, fir: FirFilter, t_knots, x_knots):
     Returns the filtered positions, shape (n, 3), and the filter lag in samples."""
     ts = fir.period_s
     n_cmd = int(np.ceil(t_knots[-1] / ts - 1e-9)) + 1
-    x = np.empty((n_cmd, 3))
-    _fir_loops.sample_command(n_cmd, ts, t_knots, np.ascontiguousarray(x_knots), x)
-    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
-    pos = fir._apply_rows(x)
     n1, n2 = fir.taps
     lag = n1 + n2 - 2
+    pos = np.empty((n_cmd + lag, 3))
+    x = pos[:n_cmd]  # the command, filtered in place
+    _fir_loops.sample_command(n_cmd, ts, t_knots, np.ascontiguousarray(x_knots), x)
+    x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
+    first, last = x[0].copy(), x[-1].copy()
+    head = _first_change(x, first)  # samples at rest at the start
+    still = _first_change(x[::-1], last)  # and at the end
+    fir._apply_rows(x, pos)
     # the filter's sums of equal values carry rounding: rest is exact at both ends
-    pos[: _first_change(x, x[0])] = x[0]
-    still = _first_change(x[::-1], x[-1])  # samples at rest at the end
-    pos[n_cmd - still + lag if still < n_cmd else 0 :] = x[-1]
+    pos[:head] = first
+    pos[n_cmd - still + lag if still < n_cmd else 0 :] = last
     return pos, lag
 
 
-def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray):
-    """Axis velocities of ``pos`` (n, 3), and the largest ratio of axis velocity, acceleration
-    and jerk to their limits (3, 3) per sample.
-
-    Derivatives are backward differences, velocity 0 at the first sample. Returns the
-    velocities (n, 3) and the ratios, shape (n,), or None when no sample exceeds a limit (the
-    common case, checked first on the peaks of one compiled pass)."""
-    vel = np.empty_like(pos)
-    peak = _fir_loops.derivative_peaks(pos, ts, vel)
+def _limit_ratio(pos: np.ndarray, ts: float, limits: np.ndarray) -> np.ndarray | None:
+    """The largest ratio of axis velocity, acceleration and jerk to their limits (3, 3) per
+    sample of ``pos`` (n, 3), shape (n,); None when no sample exceeds a limit (the common case,
+    checked first on the peaks of one compiled pass). Derivatives are backward differences."""
+    peak = _fir_loops.derivative_peaks(pos, ts)
     over = peak > limits * (1.0 + LIMIT_RTOL)  # (order, axis) above the limit
     if not over.any():
-        return vel, None
-    ratio = np.empty(len(vel))
-    _fir_loops.limit_ratios(vel, ts, limits, over, ratio)
-    return vel, ratio
+        return None
+    ratio = np.empty(len(pos))
+    _fir_loops.limit_ratios(pos, ts, limits, over, ratio)
+    return ratio
+
+
+def _velocities(pos: np.ndarray, ts: float) -> np.ndarray:
+    """Axis velocities of ``pos`` (n, 3), backward differences, 0 at the first sample."""
+    vel = np.empty_like(pos)
+    vel[0] = 0.0
+    np.subtract(pos[1:], pos[:-1], out=vel[1:])
+    vel[1:] /= ts
+    return vel
 
 
 def _moves(tp: Toolpath) -> np.ndarray:
@@ -539,7 +549,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     for _ in range(MAX_SLOWDOWNS + 1):
         t_knots = cmd.knot_times(scale)
         pos, lag = _interpolate(tp, fir, _refined(t_knots, refinement), x_knots)
-        vel, ratio = _limit_ratio(pos, ts, limits)
+        ratio = _limit_ratio(pos, ts, limits)
         if ratio is None:
             break
         # slow the command over the windows that made the violating samples
@@ -552,6 +562,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         factor = _fir_loops.range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
         slow = factor < 1.0
         scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
+    vel = _velocities(pos, ts)
     t = np.arange(len(pos)) * ts
     # block of each sample: the command's block at the centre of the filter window
     first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
