@@ -4,6 +4,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from nctwin import parse
+from nctwin.geometry import PathGeometry
 from nctwin.kernel import _fir_loops
 
 PERIOD_S = 0.001
@@ -120,3 +122,23 @@ def test_range_min_equals_brute_force(seed, n, ranges):
     for a, b, v in zip(lo, hi, value, strict=True):
         expected[a:b] = np.minimum(expected[a:b], v)
     np.testing.assert_array_equal(_fir_loops.range_min(n, lo, hi, value), expected)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    k=st.integers(0, 3 * _fir_loops.BATCH),
+    nodes=st.integers(1, 24),
+)
+def test_filtered_points_equal_einsum_of_points(seed, k, nodes):
+    rng = np.random.default_rng(seed)
+    geo = PathGeometry(parse("G1 X10 F600\nG3 X20 Y10 Z2 I0 J10\nG1 Y20\nG2 X30 Y30 I10\nG1 X0 Y0"))
+    s = rng.uniform(-1, geo.total_mm + 1, k)
+    speed = rng.uniform(0, 200, k)
+    offsets = rng.normal(0, 0.05, nodes)
+    weights = rng.random(nodes)
+    out = np.empty((k, 3))
+    _fir_loops.filtered_points(s, speed, offsets, weights, geo.loop_arrays, out)
+    pts = geo.points((s[:, None] + speed[:, None] * offsets[None, :]).ravel())
+    expected = np.einsum("l,klc->kc", weights, pts.reshape(k, nodes, 3))
+    np.testing.assert_array_equal(out, expected)

@@ -26,6 +26,9 @@ class PathGeometry:
     ----------
     s_start_mm : ndarray, shape (N + 1,)
         Arc length at the start of each block, and the total length last.
+    loop_arrays : tuple of ndarray
+        What :func:`~nctwin._geometry_loops.path_points` reads of the path, in its order: for
+        compiled loops that evaluate points themselves.
     """
 
     def __init__(self, toolpath: Toolpath) -> None:
@@ -47,6 +50,20 @@ class PathGeometry:
         rel_end = tp.end_mm - tp.center_mm
         self._r0 = np.hypot(rel[rows, ax[:, 0]], rel[rows, ax[:, 1]])
         self._r1 = np.hypot(rel_end[rows, ax[:, 0]], rel_end[rows, ax[:, 1]])
+        self.loop_arrays = (
+            self.s_start_mm,
+            self.lengths_mm,
+            tp.start_mm,
+            self._chord,
+            self._arc,
+            self._ax,
+            self._theta0,
+            self._sweep,
+            self._r0,
+            self._r1,
+            tp.center_mm,
+            self._dn,
+        )
 
     def block_at(self, s_mm: np.ndarray) -> np.ndarray:
         """Index of the block containing each arc length, shape like ``s_mm``."""
@@ -63,22 +80,7 @@ class PathGeometry:
         out = np.zeros((len(s), 3))
         if len(tp) == 0:
             return out
-        path_points(
-            s,
-            self.s_start_mm,
-            self.lengths_mm,
-            tp.start_mm,
-            self._chord,
-            self._arc,
-            self._ax,
-            self._theta0,
-            self._sweep,
-            self._r0,
-            self._r1,
-            tp.center_mm,
-            self._dn,
-            out,
-        )
+        path_points(s, *self.loop_arrays, out)
         return out
 
     def points_numpy(self, s_mm: np.ndarray) -> np.ndarray:

@@ -1,6 +1,6 @@
 """Compiled sample loops of the FIR kernel (numba): sampling the command, the box cascade and the
-axis-limit extremes, one pass over the samples each; and the minimum over covering ranges that
-lowers the speed command.
+axis-limit extremes, one pass over the samples each; the look-ahead's filtered path points; and
+the minimum over covering ranges that lowers the speed command.
 
 Each loop performs the same floating-point operations, in the same order, as the numpy code it
 replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``), so the kernel's output
@@ -13,7 +13,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["box_cascade", "derivative_peaks", "limit_ratios", "range_min", "sample_command"]
+from .._geometry_loops import path_points
+
+__all__ = [
+    "box_cascade",
+    "derivative_peaks",
+    "filtered_points",
+    "limit_ratios",
+    "range_min",
+    "sample_command",
+]
 
 
 @njit(cache=True)
@@ -193,6 +202,39 @@ def limit_ratios(pos, period_s, limits, over, ratio):  # pragma: no cover - comp
         end = 3 * (r1 - r0) + 3
         vel[:3] = vel[end - 3 : end]
         acc[:3] = acc[end - 3 : end]
+
+
+#: Junctions per batch of :func:`filtered_points` (its buffers are reused batch by batch).
+BATCH = 64
+
+
+@njit(cache=True)
+def filtered_points(s_mm, speed_mm_s, offsets_s, weights, path, out):  # pragma: no cover - compiled
+    """The filter's weighted mean of path points around each of K arc lengths, at a speed.
+
+    ``s_mm``, ``speed_mm_s`` (K,); ``offsets_s``, ``weights`` (L,); ``path`` the arrays of
+    :attr:`nctwin.geometry.PathGeometry.loop_arrays`. Writes ``out`` (K, 3): the sum over ``l``
+    of ``weights[l]`` times the point at ``s_mm[k] + speed_mm_s[k] * offsets_s[l]``, summed in
+    order of ``l`` from 0.0, as ``np.einsum("l,klc->kc", ...)`` does. The points are found by
+    :func:`~nctwin._geometry_loops.path_points`, :data:`BATCH` junctions at a time.
+    """
+    nodes = len(weights)
+    s = np.empty(BATCH * nodes)
+    points = np.empty((BATCH * nodes, 3))
+    for k0 in range(0, len(s_mm), BATCH):
+        k1 = min(k0 + BATCH, len(s_mm))
+        q = s[: (k1 - k0) * nodes]
+        p = points[: len(q)]
+        for k in range(k0, k1):
+            for j in range(nodes):
+                q[(k - k0) * nodes + j] = s_mm[k] + speed_mm_s[k] * offsets_s[j]
+        path_points(q, *path, p)
+        for k in range(k0, k1):
+            for c in range(3):
+                acc = 0.0
+                for j in range(nodes):
+                    acc += weights[j] * p[(k - k0) * nodes + j, c]
+                out[k, c] = acc
 
 
 @njit(cache=True)

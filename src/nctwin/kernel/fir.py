@@ -218,9 +218,8 @@ def _filtered_deviation(geo, s_mm, point_mm, speed_mm_s, fir: FirFilter) -> np.n
     straight within a node. Shape (K,).
     """
     w, offsets = _deviation_nodes(fir)
-    s = s_mm[:, None] + speed_mm_s[:, None] * offsets[None, :]
-    pts = geo.points(s.ravel()).reshape(len(s_mm), len(w), 3)
-    filt = np.einsum("l,klc->kc", w, pts)
+    filt = np.empty((len(s_mm), 3))
+    _fir_loops.filtered_points(s_mm, speed_mm_s, offsets, w, geo.loop_arrays, filt)
     return np.linalg.norm(filt - point_mm, axis=1)
 
 
