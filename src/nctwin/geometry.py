@@ -38,18 +38,20 @@ class PathGeometry:
         self.s_start_mm = np.concatenate([[0.0], np.cumsum(self.lengths_mm)])
         self.total_mm = float(self.s_start_mm[-1])
         self._arc = tp.is_arc
-        ax = PLANE_AXES[tp.plane]
-        rows = np.arange(len(tp))
-        rel = tp.start_mm - tp.center_mm
-        self._ax = ax
-        self._theta0 = np.arctan2(rel[rows, ax[:, 1]], rel[rows, ax[:, 0]])
-        d = tp.end_mm - tp.start_mm
-        self._chord = d
-        self._dn = d[rows, ax[:, 2]]
+        self._ax = PLANE_AXES[tp.plane]
+        self._chord = tp.end_mm - tp.start_mm
         self._sweep = tp.sweep_rad
-        rel_end = tp.end_mm - tp.center_mm
-        self._r0 = np.hypot(rel[rows, ax[:, 0]], rel[rows, ax[:, 1]])
-        self._r1 = np.hypot(rel_end[rows, ax[:, 0]], rel_end[rows, ax[:, 1]])
+        # the arcs' start angle, start and end radius and travel along the normal (0 on lines,
+        # where nothing reads them)
+        self._theta0, self._r0, self._r1, self._dn = (np.zeros(len(tp)) for _ in range(4))
+        arc = np.flatnonzero(self._arc)
+        if len(arc):
+            sa, sb, _ = tp._in_plane(tp.start_mm[arc] - tp.center_mm[arc], arc)
+            ea, eb, _ = tp._in_plane(tp.end_mm[arc] - tp.center_mm[arc], arc)
+            self._theta0[arc] = np.arctan2(sb, sa)
+            self._r0[arc] = np.hypot(sa, sb)
+            self._r1[arc] = np.hypot(ea, eb)
+            self._dn[arc] = self._chord[arc, self._ax[arc, 2]]
         self.loop_arrays = (
             self.s_start_mm,
             self.lengths_mm,

@@ -159,10 +159,13 @@ class Toolpath:
     def _plane_axes(self) -> np.ndarray:
         return PLANE_AXES[self.plane]
 
-    def _in_plane(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Coordinates of points ``p`` (N, 3) along each block's first, second and normal axis."""
-        ax = self._plane_axes
-        rows = np.arange(len(self))
+    def _in_plane(
+        self, p: np.ndarray, blocks: np.ndarray | slice = slice(None)
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Coordinates of points ``p`` (B, 3), one per block of ``blocks`` (default: all), along
+        each block's first, second and normal axis."""
+        ax = self._plane_axes[blocks]
+        rows = np.arange(len(ax))
         return p[rows, ax[:, 0]], p[rows, ax[:, 1]], p[rows, ax[:, 2]]
 
     @cached_property
@@ -175,25 +178,29 @@ class Toolpath:
     @cached_property
     def sweep_rad(self) -> np.ndarray:
         """Signed swept angle of arcs (positive counter-clockwise), shape (N,); 0 for others."""
-        with np.errstate(invalid="ignore"):
-            sweep = arc_sweep(
-                self.start_mm,
-                self.end_mm,
-                self.center_mm,
-                self.plane,
-                self.kind == MotionKind.ARC_CCW,
-            )
-        return np.where(self.is_arc, sweep, 0.0)
+        sweep = np.zeros(len(self))
+        arc = self.is_arc
+        if arc.any():
+            with np.errstate(invalid="ignore"):
+                sweep[arc] = arc_sweep(
+                    self.start_mm[arc],
+                    self.end_mm[arc],
+                    self.center_mm[arc],
+                    self.plane[arc],
+                    self.kind[arc] == MotionKind.ARC_CCW,
+                )
+        return sweep
 
     # --------------------------------------------------------------- lengths
     @cached_property
     def lengths_mm(self) -> np.ndarray:
         """Path length of each block (arc length for arcs, helix included), shape (N,)."""
-        chord = np.linalg.norm(self.end_mm - self.start_mm, axis=1)
-        _, _, dn = self._in_plane(self.end_mm - self.start_mm)
-        with np.errstate(invalid="ignore"):
-            arc = np.hypot(self.radius_mm * self.sweep_rad, dn)
-        out = np.where(self.is_arc, arc, chord)
+        out = np.linalg.norm(self.end_mm - self.start_mm, axis=1)  # the chord of lines
+        arc = np.flatnonzero(self.is_arc)
+        if len(arc):
+            _, _, dn = self._in_plane(self.end_mm[arc] - self.start_mm[arc], arc)
+            with np.errstate(invalid="ignore"):
+                out[arc] = np.hypot(self.radius_mm[arc] * self.sweep_rad[arc], dn)
         out[self.kind == MotionKind.DWELL] = 0.0
         return out
 
@@ -210,36 +217,36 @@ class Toolpath:
         n = np.linalg.norm(d, axis=1, keepdims=True)
         return np.divide(d, n, out=np.zeros_like(d), where=n > 0)
 
-    def _arc_tangent(self, at_end: bool) -> np.ndarray:
-        """Unit tangent of arcs at start or end, shape (N, 3); NaN rows for non-arcs."""
-        point = self.end_mm if at_end else self.start_mm
-        ra, rb, _ = self._in_plane(point - self.center_mm)
-        r = np.hypot(ra, rb)
-        ccw = np.where(self.kind == MotionKind.ARC_CCW, 1.0, -1.0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ua, ub = -rb / r * ccw, ra / r * ccw
-            _, _, dn = self._in_plane(self.end_mm - self.start_mm)
-            planar = r * np.abs(self.sweep_rad)
-            total = np.hypot(planar, dn)
-            t = np.zeros((len(self), 3))
-            ax = self._plane_axes
-            rows = np.arange(len(self))
-            t[rows, ax[:, 0]] = ua * planar / total
-            t[rows, ax[:, 1]] = ub * planar / total
-            t[rows, ax[:, 2]] = dn / total
-        return t
+    def _tangents(self, at_end: bool) -> np.ndarray:
+        """Unit tangent of each block at its start or end, shape (N, 3): the chord direction of
+        lines, the arc's tangent (helix included) of arcs; zeros where undefined."""
+        t = self.directions.copy()
+        arc = np.flatnonzero(self.is_arc)
+        if len(arc):
+            point = (self.end_mm if at_end else self.start_mm)[arc]
+            ra, rb, _ = self._in_plane(point - self.center_mm[arc], arc)
+            r = np.hypot(ra, rb)
+            ccw = np.where(self.kind[arc] == MotionKind.ARC_CCW, 1.0, -1.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                ua, ub = -rb / r * ccw, ra / r * ccw
+                _, _, dn = self._in_plane(self.end_mm[arc] - self.start_mm[arc], arc)
+                planar = r * np.abs(self.sweep_rad[arc])
+                total = np.hypot(planar, dn)
+                ax = self._plane_axes[arc]
+                t[arc, ax[:, 0]] = ua * planar / total
+                t[arc, ax[:, 1]] = ub * planar / total
+                t[arc, ax[:, 2]] = dn / total
+        return np.nan_to_num(t, nan=0.0)
 
     @cached_property
     def start_tangents(self) -> np.ndarray:
         """Unit tangent at the start of each block, shape (N, 3); zeros where undefined."""
-        t = np.where(self.is_arc[:, None], self._arc_tangent(False), self.directions)
-        return np.nan_to_num(t, nan=0.0)
+        return self._tangents(at_end=False)
 
     @cached_property
     def end_tangents(self) -> np.ndarray:
         """Unit tangent at the end of each block, shape (N, 3); zeros where undefined."""
-        t = np.where(self.is_arc[:, None], self._arc_tangent(True), self.directions)
-        return np.nan_to_num(t, nan=0.0)
+        return self._tangents(at_end=True)
 
     @cached_property
     def corner_angles_rad(self) -> np.ndarray:
