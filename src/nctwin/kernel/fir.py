@@ -562,10 +562,11 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         slow = factor < 1.0
         scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
     vel = _velocities(pos, ts)
-    t = np.arange(len(pos)) * ts
+    t = np.arange(len(pos), dtype=np.float64)
+    t *= ts
     # block of each sample: the command's block at the centre of the filter window
     first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
     counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
     counts[0] += min(first_sample[0], len(t))
-    block = np.repeat(cmd.segment_blocks(), counts)
-    return Motion(t, pos, vel, kept[block], ts)
+    block = np.repeat(kept[cmd.segment_blocks()], counts)
+    return Motion(t, pos, vel, block, ts)
