@@ -304,17 +304,21 @@ def plan(
             if not len(active):
                 break
             a = active
-            with np.errstate(divide="ignore", invalid="ignore"):
-                slope = np.where(lo[a] > 0, np.log(e_hi[a] / e_lo[a]) / np.log(hi[a] / lo[a]), 1.0)
-                slope = np.clip(np.nan_to_num(slope, nan=1.0), 0.5, 4.0)
-                guess = hi[a] * (tol_j[a] / e_hi[a]) ** (1.0 / slope)
-            inside = (guess > lo[a]) & (guess < hi[a]) & (it % 2 == 0)  # odd steps bisect
-            guess = np.where(inside, guess, 0.5 * (lo[a] + hi[a]))
+            lo_a, hi_a, e_lo_a, e_hi_a, tol_a = lo[a], hi[a], e_lo[a], e_hi[a], tol_j[a]
+            guess = 0.5 * (lo_a + hi_a)  # odd steps bisect
+            if it % 2 == 0:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    slope = np.where(lo_a > 0, np.log(e_hi_a / e_lo_a) / np.log(hi_a / lo_a), 1.0)
+                    slope = np.clip(np.where(np.isnan(slope), 1.0, slope), 0.5, 4.0)
+                    secant = hi_a * (tol_a / e_hi_a) ** (1.0 / slope)
+                inside = (secant > lo_a) & (secant < hi_a)
+                guess[inside] = secant[inside]
             e = _filtered_deviation(geo, s_j[a], p_j[a], guess, fir)
-            ok = e <= tol_j[a]
-            lo[a[ok]], e_lo[a[ok]] = guess[ok], e[ok]
-            hi[a[~ok]], e_hi[a[~ok]] = guess[~ok], e[~ok]
-            done = (hi[a] - lo[a] <= V_RTOL * hi[a]) | (e_lo[a] >= (1 - V_RTOL) * tol_j[a])
+            ok = e <= tol_a
+            lo_a[ok], e_lo_a[ok] = guess[ok], e[ok]
+            hi_a[~ok], e_hi_a[~ok] = guess[~ok], e[~ok]
+            lo[a], hi[a], e_lo[a], e_hi[a] = lo_a, hi_a, e_lo_a, e_hi_a
+            done = (hi_a - lo_a <= V_RTOL * hi_a) | (e_lo_a >= (1 - V_RTOL) * tol_a)
             active = a[~done]
         v[jj] = np.where(e_hi <= tol_j, hi, lo)
     # waiting: the filters drain before a stop (not after a dwell, already at rest), and dwells
