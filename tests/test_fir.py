@@ -81,6 +81,17 @@ def test_filter_is_the_convolution_with_its_weights(t2_s):
     np.testing.assert_allclose(out, expected, rtol=0, atol=1e-9)
 
 
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300))
+def test_unique_with_index_equals_unique_and_searchsorted(seed, n):
+    rng = np.random.default_rng(seed)
+    x = np.round(rng.uniform(0, 50, n), int(rng.integers(0, 3)))  # repeated values
+    x[: n // 2].sort()  # a sorted run, as the command's block starts
+    cuts, index = fir._unique_with_index(x)
+    np.testing.assert_array_equal(cuts, np.unique(x))
+    np.testing.assert_array_equal(index, np.searchsorted(cuts, x))
+
+
 def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0

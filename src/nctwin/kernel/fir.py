@@ -364,6 +364,22 @@ class _Command:
         return np.where(seg < 0, np.roll(seg, -1), seg)
 
 
+def _unique_with_index(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct values of ``x`` (N,), sorted, as ``np.unique``, and the index of each
+    element among them (N,), as ``np.searchsorted`` would find it (no signed zeros or NaN).
+
+    A stable sort: it merges the sorted runs the command's arc lengths come in (block starts,
+    and the windows around them), where ``np.unique``'s quicksort sorts from scratch."""
+    order = np.argsort(x, kind="stable")
+    x = x[order]
+    new = np.empty(len(x), dtype=bool)
+    new[:1] = True
+    np.not_equal(x[1:], x[:-1], out=new[1:])
+    index = np.empty(len(x), dtype=np.intp)
+    index[order] = np.cumsum(new) - 1
+    return x[new], index
+
+
 def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Command:
     """The speed command: block feeds, lowered to each junction's speed over the filter window
     centred on it, and the pauses."""
@@ -374,15 +390,13 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Comma
     zone = (v > 0) & np.isfinite(v)
     z_lo = np.maximum(s_start[zone] - v[zone] * half, 0.0)
     z_hi = np.minimum(s_start[zone] + v[zone] * half, geo.total_mm)
-    cuts = np.unique(np.concatenate([s_start, z_lo, z_hi]))
+    cuts, index = _unique_with_index(np.concatenate([s_start, z_lo, z_hi]))
+    at, i_lo, i_hi = np.split(index, [len(s_start), len(s_start) + len(z_lo)])
     mid = 0.5 * (cuts[:-1] + cuts[1:])
     block = geo.block_at(mid)
     speed = p.feed_mm_s[block].copy()
     if zone.any():
-        i_lo = np.searchsorted(cuts, z_lo)
-        i_hi = np.searchsorted(cuts, z_hi)
         speed = np.minimum(speed, _fir_loops.range_min(len(mid), i_lo, i_hi, v[zone]))
-    at = np.searchsorted(cuts, s_start)
     pause = np.zeros(len(cuts))
     np.add.at(pause, at, p.pause_s)
     # a pause belongs to the dwell it is, else to the block that ends at the stop
