@@ -177,28 +177,33 @@ def limit_ratios(pos, period_s, limits, over, ratio):  # pragma: no cover - comp
     ``limits`` (3, 3) as the peaks of :func:`derivative_peaks` (row = order, column = axis);
     writes ``ratio`` (n,): the derivative of order ``k`` (0 velocity, 1 acceleration, 2 jerk)
     counts at sample ``i`` from ``i = k + 1`` on, 0 where none counts. The same differences as
-    :func:`derivative_peaks` (and ``np.diff`` over the period), by chunks.
+    :func:`derivative_peaks` (and ``np.diff`` over the period), by chunks; in a chunk, one
+    branch-free loop over its samples per marked pair, axis by axis and order by order, the
+    order in which a sample's maximum takes them.
     """
     n = pos.shape[0]
     flat = pos.reshape(-1)
     vel = np.empty(3 * CHUNK + 3)
     acc = np.empty(3 * CHUNK + 3)
-    ratio[:1] = 0.0
+    ratio[:] = 0.0
     for r0 in range(1, n, CHUNK):
         r1 = min(r0 + CHUNK, n)
         _chunk_derivatives(flat, r0, r1, period_s, vel, acc)
-        for i in range(r0, r1):
-            k = 3 * (i - r0) + 3
-            top = 0.0
-            for a in range(3):
-                if over[0, a]:
-                    top = max(top, abs(vel[k + a]) / limits[0, a])
-                if i >= 2 and over[1, a]:
-                    top = max(top, abs(acc[k + a]) / limits[1, a])
-                if i >= 3 and over[2, a]:
-                    jerk = (acc[k + a] - acc[k + a - 3]) / period_s
-                    top = max(top, abs(jerk) / limits[2, a])
-            ratio[i] = top
+        for a in range(3):
+            for order in range(3):
+                if not over[order, a]:
+                    continue
+                first = max(r0, order + 1)  # the first sample the derivative counts at
+                limit = limits[order, a]
+                for i in range(first, r1):
+                    k = 3 * (i - r0) + 3 + a
+                    if order == 0:
+                        r = abs(vel[k]) / limit
+                    elif order == 1:
+                        r = abs(acc[k]) / limit
+                    else:
+                        r = abs((acc[k] - acc[k - 3]) / period_s) / limit
+                    ratio[i] = max(ratio[i], r)
         end = 3 * (r1 - r0) + 3
         vel[:3] = vel[end - 3 : end]
         acc[:3] = acc[end - 3 : end]
