@@ -142,3 +142,33 @@ def test_filtered_points_equal_einsum_of_points(seed, k, nodes):
     pts = geo.points((s[:, None] + speed[:, None] * offsets[None, :]).ravel())
     expected = np.einsum("l,klc->kc", weights, pts.reshape(k, nodes, 3))
     np.testing.assert_array_equal(out, expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), c=st.integers(1, 60))
+def test_knot_times_equal_numpy_running_sums(seed, c):
+    rng = np.random.default_rng(seed)
+    cuts = np.cumsum(rng.uniform(0.001, 5.0, c))
+    speed = rng.uniform(1.0, 200.0, c - 1)
+    pause = np.where(rng.random(c) < 0.3, rng.uniform(0.0, 0.1, c), 0.0)
+    out = np.empty(2 * c)
+    _fir_loops.knot_times(cuts, speed, pause, out)
+    arrive = np.concatenate([[0.0], np.cumsum(np.diff(cuts) / speed)])
+    arrive[1:] += np.cumsum(pause)[:-1]
+    np.testing.assert_array_equal(out, np.column_stack([arrive, arrive + pause]).ravel())
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), segments=st.integers(1, 60), delay=st.integers(0, 30))
+def test_sample_blocks_equal_numpy_repeat(seed, segments, delay):
+    rng = np.random.default_rng(seed)
+    steps = np.where(rng.random(segments) < 0.3, 0.0, rng.exponential(0.005, segments))
+    t_knots = np.concatenate([[0.0], np.cumsum(steps)])
+    segment_block = rng.integers(0, 1000, segments)
+    n = int(np.ceil(t_knots[-1] / PERIOD_S)) + 2 * delay + 1
+    out = np.empty(n, dtype=np.int64)
+    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, segment_block, out)
+    first = np.ceil(t_knots[:-1] / PERIOD_S - 1e-9).astype(np.int64) + delay
+    counts = np.diff(np.concatenate([np.clip(first, 0, n), [n]]))
+    counts[0] += min(first[0], n)
+    np.testing.assert_array_equal(out, np.repeat(segment_block, counts))

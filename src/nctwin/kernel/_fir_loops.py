@@ -1,6 +1,7 @@
-"""Compiled sample loops of the FIR kernel (numba): sampling the command, the box cascade and the
-axis-limit extremes, one pass over the samples each; the look-ahead's filtered path points; and
-the minimum over covering ranges that lowers the speed command.
+"""Compiled loops of the FIR kernel (numba): sampling the command, the box cascade and the
+axis-limit extremes, one pass over the samples each; the look-ahead's filtered path points; the
+minimum over covering ranges that lowers the speed command; the command's time knots and the
+block of each sample.
 
 Each loop performs the same floating-point operations, in the same order, as the numpy code it
 replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``), so the kernel's output
@@ -19,8 +20,10 @@ __all__ = [
     "box_cascade",
     "derivative_peaks",
     "filtered_points",
+    "knot_times",
     "limit_ratios",
     "range_min",
+    "sample_blocks",
     "sample_command",
 ]
 
@@ -265,3 +268,50 @@ def range_min(n, lo, hi, value):  # pragma: no cover - compiled
                 skip[c] = hi[r]  # every cell up to hi[r] is painted once this range is done
                 c += 1
     return out
+
+
+@njit(cache=True)
+def knot_times(cuts, speed, pause, out):  # pragma: no cover - compiled
+    """Arrival at and departure from each of C cuts of a speed command, ``out`` (2C,).
+
+    ``cuts`` (C,) increasing arc lengths, ``speed`` (C - 1,) of the intervals between them,
+    ``pause`` (C,) the wait at each cut. Arrival at cut ``k`` is the running sum of the
+    durations ``(cuts[i + 1] - cuts[i]) / speed[i]``, ``i < k``, plus that of the pauses before
+    it, departure the arrival plus its pause: the sums as ``np.cumsum`` forms them (from
+    ``-0.0``, the additive identity, so the first sum is the first term).
+    """
+    moving = -0.0
+    paused = -0.0
+    out[0] = 0.0
+    out[1] = 0.0 + pause[0]
+    for k in range(1, len(cuts)):
+        moving += (cuts[k] - cuts[k - 1]) / speed[k - 1]
+        paused += pause[k - 1]
+        arrive = moving + paused
+        out[2 * k] = arrive
+        out[2 * k + 1] = arrive + pause[k]
+
+
+@njit(cache=True)
+def _first_sample(t, period_s, delay):  # pragma: no cover - compiled
+    """The first sample at or after time ``t`` (1e-9 periods of slack), ``delay`` samples on."""
+    return int(np.ceil(t / period_s - 1e-9)) + delay
+
+
+@njit(cache=True)
+def sample_blocks(t_knots, period_s, delay, segment_block, out):  # pragma: no cover - compiled
+    """Block of each sample, ``out`` (n,), from the blocks of the time segments between knots.
+
+    ``t_knots`` (S + 1,) non-decreasing, ``segment_block`` (S,): segment ``s`` owns the samples
+    from its start's :func:`_first_sample` up to the next segment's, the first segment every
+    sample before that too; one walk over samples and segments together.
+    """
+    segments = len(segment_block)
+    s = 0
+    next_start = _first_sample(t_knots[1], period_s, delay) if segments > 1 else 0
+    for i in range(len(out)):
+        while s + 1 < segments and next_start <= i:
+            s += 1
+            if s + 1 < segments:
+                next_start = _first_sample(t_knots[s + 1], period_s, delay)
+        out[i] = segment_block[s]

@@ -347,10 +347,9 @@ class _Command:
         """Time knots (2C,) of the command, speeds multiplied by ``scale``: arrival at and
         departure from each cut, whose arc length is :attr:`knot_s`."""
         speed = self.speed if scale is None else self.speed * scale
-        dur = np.diff(self.cuts) / speed
-        arrive = np.concatenate([[0.0], np.cumsum(dur)])
-        arrive[1:] += np.cumsum(self.pause)[:-1]
-        return np.column_stack([arrive, arrive + self.pause]).ravel()
+        knots = np.empty(2 * len(self.cuts))
+        _fir_loops.knot_times(self.cuts, speed, self.pause, knots)
+        return knots
 
     @property
     def knot_s(self) -> np.ndarray:
@@ -583,8 +582,6 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     t = np.arange(len(pos), dtype=np.float64)
     t *= ts
     # block of each sample: the command's block at the centre of the filter window
-    first_sample = np.ceil(t_knots[:-1] / ts - 1e-9).astype(np.int64) + lag // 2
-    counts = np.diff(np.concatenate([np.clip(first_sample, 0, len(t)), [len(t)]]))
-    counts[0] += min(first_sample[0], len(t))
-    block = np.repeat(kept[cmd.segment_blocks()], counts)
+    block = np.empty(len(pos), dtype=kept.dtype)
+    _fir_loops.sample_blocks(t_knots, ts, lag // 2, kept[cmd.segment_blocks()], block)
     return Motion(t, pos, vel, block, ts)
