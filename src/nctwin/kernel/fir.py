@@ -358,9 +358,12 @@ class _Command:
 
     def segment_blocks(self) -> np.ndarray:
         """Block of each of the 2C - 1 time segments between knots (pause, move, pause, ...)."""
-        moving = np.append(self.block, self.block[-1] if len(self.block) else 0)
-        seg = np.column_stack([self.pause_block, moving]).ravel()[:-1]
-        return np.where(seg < 0, np.roll(seg, -1), seg)
+        seg = np.empty(2 * len(self.pause_block) - 1, dtype=self.block.dtype)
+        seg[0::2] = self.pause_block
+        seg[1::2] = self.block
+        unowned = np.flatnonzero(seg < 0)  # pauses of no block: the next segment's (cyclically)
+        seg[unowned] = seg[(unowned + 1) % len(seg)]
+        return seg
 
 
 def _unique_with_index(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -410,15 +413,19 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Comma
 ARC_CHORD_TOL_MM = 1e-6
 
 
-def _arc_refinement(tp: Toolpath, geo: PathGeometry, s_knots: np.ndarray):
+def _arc_refinement(tp: Toolpath, geo: PathGeometry, cmd: _Command):
     """Knots to add inside arcs so that interpolating positions linearly in time between knots
     stays within :data:`ARC_CHORD_TOL_MM` of the arc (speed is constant between knots).
 
-    Returns, for the refined knots, the interval of ``s_knots`` each starts and its fraction of
-    the way along it (both shape (R,)), for :func:`_refined`; None where no knot is added. The
-    refinement depends on arc lengths only: it holds for the time knots of every pass."""
+    Returns, for the refined knots, the interval of the command's :attr:`~_Command.knot_s` each
+    starts and its fraction of the way along it (both shape (R,)), for :func:`_refined`; None
+    where no knot is added (at once without arcs). The refinement depends on arc lengths only:
+    it holds for the time knots of every pass."""
+    if not tp.is_arc.any():
+        return None
+    s_knots = cmd.knot_s
     ds = np.diff(s_knots)
-    if not tp.is_arc.any() or not len(ds):
+    if not len(ds):
         return None
     mid = 0.5 * (s_knots[:-1] + s_knots[1:])
     b = geo.block_at(mid)
@@ -556,7 +563,7 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
         ]
     )
     # the path points of the knots are the same in every pass: computed once
-    refinement = _arc_refinement(tp, geo, cmd.knot_s)
+    refinement = _arc_refinement(tp, geo, cmd)
     if refinement is None:
         x_knots = np.repeat(geo.points(cmd.cuts), 2, axis=0)
     else:
