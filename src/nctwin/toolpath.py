@@ -24,6 +24,8 @@ from functools import cached_property
 
 import numpy as np
 
+from ._rows import row_norm
+
 __all__ = ["EVENT_DTYPE", "PLANE_AXES", "MotionKind", "PathMode", "Plane", "Toolpath"]
 
 
@@ -195,7 +197,7 @@ class Toolpath:
     @cached_property
     def lengths_mm(self) -> np.ndarray:
         """Path length of each block (arc length for arcs, helix included), shape (N,)."""
-        out = np.linalg.norm(self.end_mm - self.start_mm, axis=1)  # the chord of lines
+        out = row_norm(self.end_mm - self.start_mm)  # the chord of lines
         arc = np.flatnonzero(self.is_arc)
         if len(arc):
             _, _, dn = self._in_plane(self.end_mm[arc] - self.start_mm[arc], arc)
@@ -214,7 +216,7 @@ class Toolpath:
         """Unit chord direction (end - start) of each block, shape (N, 3); zeros where the chord
         is zero (dwells, full circles, zero-length moves)."""
         d = self.end_mm - self.start_mm
-        n = np.linalg.norm(d, axis=1, keepdims=True)
+        n = row_norm(d)[:, None]
         return np.divide(d, n, out=np.zeros_like(d), where=n > 0)
 
     def _tangents(self, at_end: bool) -> np.ndarray:

@@ -43,6 +43,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from .._rows import row_min, row_norm
 from ..geometry import PathGeometry
 from ..machine import MachineProfile
 from ..motion import Motion
@@ -196,7 +197,7 @@ def _block_feeds(tp: Toolpath, machine: MachineProfile, fir: FirFilter) -> np.nd
         step = amax * fir.t1_s
         if fir.t2_s > 0:
             step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
-        f = np.minimum(f, np.min(np.minimum(vmax, step) / share, axis=1))
+        f = np.minimum(f, row_min(np.minimum(vmax, step) / share))
         if arc.any():
             r = tp.radius_mm[arc]
             a_plane = np.minimum(amax[ax[:, 0]], amax[ax[:, 1]])
@@ -220,7 +221,7 @@ def _filtered_deviation(geo, s_mm, point_mm, speed_mm_s, fir: FirFilter) -> np.n
     w, offsets = _deviation_nodes(fir)
     filt = np.empty((len(s_mm), 3))
     _fir_loops.filtered_points(s_mm, speed_mm_s, offsets, w, geo.loop_arrays, filt)
-    return np.linalg.norm(filt - point_mm, axis=1)
+    return row_norm(filt - point_mm)
 
 
 #: Share of the tolerance kept in reserve: the plan evaluates the filter at the junction's
@@ -277,7 +278,7 @@ def plan(
         step = amax * fir.t1_s
         if fir.t2_s > 0:
             step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
-        cap = np.minimum(cap, np.min(step / du, axis=1))
+        cap = np.minimum(cap, row_min(step / du))
     stop = dwell[j] | dwell[j - 1] | (tol[j] == 0)
     cap[stop] = 0.0
     v[j] = cap
@@ -523,7 +524,7 @@ def _velocities(pos: np.ndarray, ts: float) -> np.ndarray:
 def _moves(tp: Toolpath) -> np.ndarray:
     """Blocks of nonzero length, shape (N,): ``tp.lengths_mm > 0``, with the arc geometry
     (which the kernel computes again on the kept blocks) evaluated on the arcs only."""
-    moves = np.linalg.norm(tp.end_mm - tp.start_mm, axis=1) > 0  # the chord of lines
+    moves = row_norm(tp.end_mm - tp.start_mm) > 0  # the chord of lines
     arc = np.flatnonzero(tp.is_arc)
     if len(arc):
         moves[arc] = tp.take(arc).lengths_mm > 0
