@@ -92,18 +92,6 @@ def test_unique_with_index_equals_unique_and_searchsorted(seed, n):
     np.testing.assert_array_equal(index, np.searchsorted(cuts, x))
 
 
-@settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), c=st.integers(1, 40))
-def test_segment_blocks_give_unowned_pauses_the_next_segments_block(seed, c):
-    rng = np.random.default_rng(seed)
-    block = rng.integers(0, 50, c - 1)
-    pause_block = np.where(rng.random(c) < 0.5, -1, rng.integers(0, 50, c))
-    cmd = fir._Command(np.arange(c, dtype=float), np.ones(c - 1), block, np.zeros(c), pause_block)
-    seg = np.column_stack([pause_block, np.append(block, 0)]).ravel()[:-1]
-    expected = np.where(seg < 0, np.roll(seg, -1), seg)
-    np.testing.assert_array_equal(cmd.segment_blocks(), expected)
-
-
 def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0

@@ -159,16 +159,22 @@ def test_knot_times_equal_numpy_running_sums(seed, c):
 
 
 @settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), segments=st.integers(1, 60), delay=st.integers(0, 30))
-def test_sample_blocks_equal_numpy_repeat(seed, segments, delay):
+@given(seed=st.integers(0, 2**32 - 1), c=st.integers(1, 30), delay=st.integers(0, 30))
+def test_sample_blocks_equal_numpy_repeat(seed, c, delay):
     rng = np.random.default_rng(seed)
-    steps = np.where(rng.random(segments) < 0.3, 0.0, rng.exponential(0.005, segments))
+    steps = np.where(rng.random(2 * c - 1) < 0.3, 0.0, rng.exponential(0.005, 2 * c - 1))
     t_knots = np.concatenate([[0.0], np.cumsum(steps)])
-    segment_block = rng.integers(0, 1000, segments)
+    block = rng.integers(0, 20, c - 1)
+    pause_block = np.where(rng.random(c) < 0.5, -1, rng.integers(0, 20, c))
+    kept = np.sort(rng.choice(100, 20, replace=False))
     n = int(np.ceil(t_knots[-1] / PERIOD_S)) + 2 * delay + 1
     out = np.empty(n, dtype=np.int64)
-    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, segment_block, out)
+    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, pause_block, block, kept, out)
+    # the numpy it replaces: segments' blocks (an unowned pause takes the next segment's,
+    # cyclically), repeated over the samples each segment owns
+    seg = np.column_stack([pause_block, np.append(block, 0)]).ravel()[:-1]
+    seg = np.where(seg < 0, np.roll(seg, -1), seg)
     first = np.ceil(t_knots[:-1] / PERIOD_S - 1e-9).astype(np.int64) + delay
     counts = np.diff(np.concatenate([np.clip(first, 0, n), [n]]))
     counts[0] += min(first[0], n)
-    np.testing.assert_array_equal(out, np.repeat(segment_block, counts))
+    np.testing.assert_array_equal(out, np.repeat(kept[seg], counts))

@@ -299,14 +299,19 @@ def _first_sample(t, period_s, delay):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def sample_blocks(t_knots, period_s, delay, segment_block, out):  # pragma: no cover - compiled
+def sample_blocks(  # pragma: no cover - compiled
+    t_knots, period_s, delay, pause_block, block, kept, out
+):
     """Block of each sample, ``out`` (n,), from the blocks of the time segments between knots.
 
-    ``t_knots`` (S + 1,) non-decreasing, ``segment_block`` (S,): segment ``s`` owns the samples
-    from its start's :func:`_first_sample` up to the next segment's, the first segment every
-    sample before that too; one walk over samples and segments together.
+    ``t_knots`` (2C,) non-decreasing: segment ``2c`` is the pause at cut ``c``, in block
+    ``pause_block[c]`` (C,), or where that is -1 the next segment's (the last pause's: the
+    first segment's); segment ``2c + 1`` the move after it, in ``block[c]`` (C - 1,). A segment
+    owns the samples from its start's :func:`_first_sample` up to the next segment's (the
+    first segment every sample before that too); ``out[i]`` is ``kept`` of its block. One walk
+    over samples and segments together.
     """
-    segments = len(segment_block)
+    segments = len(t_knots) - 1
     s = 0
     next_start = _first_sample(t_knots[1], period_s, delay) if segments > 1 else 0
     for i in range(len(out)):
@@ -314,4 +319,10 @@ def sample_blocks(t_knots, period_s, delay, segment_block, out):  # pragma: no c
             s += 1
             if s + 1 < segments:
                 next_start = _first_sample(t_knots[s + 1], period_s, delay)
-        out[i] = segment_block[s]
+        if s % 2:
+            b = block[s // 2]
+        else:
+            b = pause_block[s // 2]
+            if b < 0:
+                b = block[s // 2] if s + 1 < segments else pause_block[0]
+        out[i] = kept[b]

@@ -357,15 +357,6 @@ class _Command:
         """Arc-length knots (2C,) of the command: each cut twice."""
         return np.repeat(self.cuts, 2)
 
-    def segment_blocks(self) -> np.ndarray:
-        """Block of each of the 2C - 1 time segments between knots (pause, move, pause, ...)."""
-        seg = np.empty(2 * len(self.pause_block) - 1, dtype=self.block.dtype)
-        seg[0::2] = self.pause_block
-        seg[1::2] = self.block
-        unowned = np.flatnonzero(seg < 0)  # pauses of no block: the next segment's (cyclically)
-        seg[unowned] = seg[(unowned + 1) % len(seg)]
-        return seg
-
 
 def _unique_with_index(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The distinct values of ``x`` (N,), sorted, as ``np.unique``, and the index of each
@@ -591,5 +582,5 @@ def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
     t *= ts
     # block of each sample: the command's block at the centre of the filter window
     block = np.empty(len(pos), dtype=kept.dtype)
-    _fir_loops.sample_blocks(t_knots, ts, lag // 2, kept[cmd.segment_blocks()], block)
+    _fir_loops.sample_blocks(t_knots, ts, lag // 2, cmd.pause_block, cmd.block, kept, block)
     return Motion(t, pos, vel, block, ts)
