@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from test_gcode import programs
 
 from nctwin import parse, parse_file
+from nctwin._geometry_loops import block_indices
 from nctwin.geometry import PathGeometry
 
 
@@ -64,3 +65,16 @@ def test_points_by_hand():
 def test_empty_path_has_points_at_the_origin():
     geo = PathGeometry(parse("G4 P0.1"))
     np.testing.assert_array_equal(geo.points(np.array([0.0, 1.0])), np.zeros((2, 3)))
+
+
+@settings(max_examples=100, deadline=None)
+@given(programs(), st.integers(0, 2**32 - 1), st.booleans())
+def test_compiled_block_indices_equal_block_at(text, seed, ordered):
+    geo = PathGeometry(parse(text))
+    if not len(geo.lengths_mm):
+        return
+    s = _queries(geo, np.random.default_rng(seed))
+    s = np.sort(s) if ordered else s
+    out = np.empty(len(s), dtype=np.intp)
+    block_indices(geo.s_start_mm, s, out)
+    np.testing.assert_array_equal(out, geo.block_at(s))

@@ -1,4 +1,4 @@
-"""Compiled loop of :meth:`nctwin.geometry.PathGeometry.points` (numba).
+"""Compiled loops of :meth:`nctwin.geometry.PathGeometry.points` and ``block_at`` (numba).
 
 It performs the same floating-point operations, in the same order, as the numpy expression it
 replaces (``np.searchsorted``, ``np.clip``, the line and arc formulas with libm's ``cos`` and
@@ -12,7 +12,51 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["path_points"]
+__all__ = ["block_index", "block_indices", "path_points"]
+
+
+@njit(cache=True)
+def block_index(s_start_mm, s, k):  # pragma: no cover - compiled
+    """The block of arc length ``s`` (not NaN) on a path of N > 0 blocks whose starts, and
+    the total length last, are ``s_start_mm`` (N + 1,): ``searchsorted(s_start_mm, s,
+    "right") - 1`` clipped to the blocks, found by galloping from block ``k`` (the block of
+    the previous query: queries come in runs near each other), then bisecting.
+    """
+    n = len(s_start_mm) - 1
+    # first index whose start exceeds s, between lo and hi
+    if s_start_mm[k] <= s:
+        lo, step = k + 1, 1
+        hi = lo
+        while hi <= n and s_start_mm[hi] <= s:
+            lo = hi + 1
+            hi = lo + step
+            step *= 2
+        hi = min(hi, n + 1)
+    else:
+        hi, step = k, 1
+        lo = hi
+        while lo > 0 and s_start_mm[lo - 1] > s:
+            hi = lo - 1
+            lo = hi - step
+            step *= 2
+        lo = max(lo, 0)
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if s_start_mm[mid] <= s:
+            lo = mid + 1
+        else:
+            hi = mid
+    return min(max(lo - 1, 0), n - 1)
+
+
+@njit(cache=True)
+def block_indices(s_start_mm, s_mm, out):  # pragma: no cover - compiled
+    """:func:`block_index` of each arc length of ``s_mm`` (Q,), not NaN, into ``out`` (Q,):
+    :meth:`nctwin.geometry.PathGeometry.block_at`, in one pass for queries in order."""
+    k = 0
+    for q in range(len(s_mm)):
+        k = block_index(s_start_mm, s_mm[q], k)
+        out[q] = k
 
 
 @njit(cache=True)
@@ -51,31 +95,7 @@ def path_points(  # pragma: no cover - compiled
             s = 0.0
         if s > total:
             s = total
-        # first index whose start exceeds s: galloping from the last query's, as queries come
-        # in runs near each other (the same index as a binary search over the whole path)
-        if s_start_mm[k] <= s:
-            lo, step = k + 1, 1
-            hi = lo
-            while hi <= n and s_start_mm[hi] <= s:
-                lo = hi + 1
-                hi = lo + step
-                step *= 2
-            hi = min(hi, n + 1)
-        else:
-            hi, step = k, 1
-            lo = hi
-            while lo > 0 and s_start_mm[lo - 1] > s:
-                hi = lo - 1
-                lo = hi - step
-                step *= 2
-            lo = max(lo, 0)
-        while lo < hi:
-            mid = (lo + hi) >> 1
-            if s_start_mm[mid] <= s:
-                lo = mid + 1
-            else:
-                hi = mid
-        k = min(max(lo - 1, 0), n - 1)
+        k = block_index(s_start_mm, s, k)
         length = lengths_mm[k]
         frac = (s - s_start_mm[k]) / length if length > 0 else 0.0
         if frac < 0.0:
