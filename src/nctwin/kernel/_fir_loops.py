@@ -4,9 +4,10 @@ minimum over covering ranges that lowers the speed command; the command's time k
 block of each sample.
 
 Each loop performs the same floating-point operations, in the same order, as the numpy code it
-replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``), so the kernel's output
-does not depend on which one ran; ``tests/test_fir_loops.py`` checks this bit for bit. numba
-compiles them on first use and caches the machine code beside this file.
+replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``, ``np.einsum``), or ones
+that give the same bits for a stated reason (a maximum divided once: :func:`derivative_peaks`),
+so the kernel's output does not depend on which one ran; ``tests/test_fir_loops.py`` checks
+this bit for bit. numba compiles them on first use and caches the machine code beside this file.
 """
 
 from __future__ import annotations
