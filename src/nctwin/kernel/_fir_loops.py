@@ -36,36 +36,45 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
     ``t_knots`` (K,) non-decreasing from 0, ``x_knots`` (K, 3); writes ``out`` (n_cmd, 3). The same
     arithmetic as ``np.interp`` per axis (value at a knot exactly, ``slope * (t - t_j) + x_j``
     inside, the last value at and after the last knot); the knot search walks forward, as the
-    sample times increase, and the slopes of a segment are computed once, when a sample first
-    falls inside it.
+    sample times increase. A segment's slopes are computed once, and its samples in one loop
+    without branches; ``np.interp``'s fallbacks where that gives NaN (infinite positions) after.
     """
     k = len(t_knots)
     j = 0
-    sloped = -1  # the segment whose slopes ``slope`` holds
-    slope = np.empty(3)
-    for i in range(n_cmd):
+    i = 0
+    while i < n_cmd:
         t = i * period_s
         while j + 1 < k and t_knots[j + 1] <= t:
             j += 1
-        if j == k - 1:
+        if j == k - 1:  # at and after the last knot
             for a in range(3):
-                out[i, a] = x_knots[k - 1, a]
-        elif t_knots[j] == t:
+                out[i:, a] = x_knots[k - 1, a]
+            return
+        if t_knots[j] == t:  # on a knot
             for a in range(3):
                 out[i, a] = x_knots[j, a]
-        else:
-            if sloped != j:
-                dt = t_knots[j + 1] - t_knots[j]
-                for a in range(3):
-                    slope[a] = (x_knots[j + 1, a] - x_knots[j, a]) / dt
-                sloped = j
+            i += 1
+            continue
+        t0, t1 = t_knots[j], t_knots[j + 1]  # the samples strictly inside segment j
+        x0, y0, z0 = x_knots[j, 0], x_knots[j, 1], x_knots[j, 2]
+        sx = (x_knots[j + 1, 0] - x0) / (t1 - t0)
+        sy = (x_knots[j + 1, 1] - y0) / (t1 - t0)
+        sz = (x_knots[j + 1, 2] - z0) / (t1 - t0)
+        first = i
+        while i < n_cmd and i * period_s < t1:
+            t = i * period_s
+            out[i, 0] = sx * (t - t0) + x0
+            out[i, 1] = sy * (t - t0) + y0
+            out[i, 2] = sz * (t - t0) + z0
+            i += 1
+        for r in range(first, i):
             for a in range(3):
-                v = slope[a] * (t - t_knots[j]) + x_knots[j, a]
-                if np.isnan(v):
-                    v = slope[a] * (t - t_knots[j + 1]) + x_knots[j + 1, a]
+                if np.isnan(out[r, a]):
+                    slope = (x_knots[j + 1, a] - x_knots[j, a]) / (t1 - t0)
+                    v = slope * (r * period_s - t1) + x_knots[j + 1, a]
                     if np.isnan(v) and x_knots[j, a] == x_knots[j + 1, a]:
                         v = x_knots[j, a]
-                out[i, a] = v
+                    out[r, a] = v
 
 
 @njit(cache=True)
