@@ -248,11 +248,13 @@ def filtered_points(s_mm, speed_mm_s, offsets_s, weights, path, out):  # pragma:
                 q[(k - k0) * nodes + j] = s_mm[k] + speed_mm_s[k] * offsets_s[j]
         path_points(q, *path, p)
         for k in range(k0, k1):
-            for c in range(3):
-                acc = 0.0
-                for j in range(nodes):
-                    acc += weights[j] * p[(k - k0) * nodes + j, c]
-                out[k, c] = acc
+            sx = sy = sz = 0.0  # the three axes' sums side by side (each in order of l)
+            for j in range((k - k0) * nodes, (k - k0 + 1) * nodes):
+                w = weights[j - (k - k0) * nodes]
+                sx += w * p[j, 0]
+                sy += w * p[j, 1]
+                sz += w * p[j, 2]
+            out[k, 0], out[k, 1], out[k, 2] = sx, sy, sz
 
 
 @njit(cache=True)
