@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._geometry_loops import path_points
+from ._geometry_loops import block_indices, path_points
 from .toolpath import PLANE_AXES, Toolpath
 
 __all__ = ["PathGeometry"]
@@ -71,6 +71,13 @@ class PathGeometry:
         """Index of the block containing each arc length, shape like ``s_mm``."""
         k = np.searchsorted(self.s_start_mm, s_mm, side="right") - 1
         return np.clip(k, 0, max(len(self.lengths_mm) - 1, 0))
+
+    def block_at_ordered(self, s_mm: np.ndarray) -> np.ndarray:
+        """:meth:`block_at` of arc lengths (Q,) in increasing order, not NaN, in one compiled
+        pass (:func:`nctwin._geometry_loops.block_indices`), shape (Q,)."""
+        out = np.empty(len(s_mm), dtype=np.intp)
+        block_indices(self.s_start_mm, np.ascontiguousarray(s_mm, dtype=np.float64), out)
+        return out
 
     def points(self, s_mm: np.ndarray) -> np.ndarray:
         """Positions at arc lengths ``s_mm`` (clipped to the path), shape (len(s_mm), 3).

@@ -43,7 +43,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._geometry_loops import block_indices
 from .._rows import row_min, row_norm
 from ..geometry import PathGeometry
 from ..machine import MachineProfile
@@ -388,8 +387,7 @@ def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Comma
     cuts, index = _unique_with_index(np.concatenate([s_start, z_lo, z_hi]))
     at, i_lo, i_hi = np.split(index, [len(s_start), len(s_start) + len(z_lo)])
     mid = 0.5 * (cuts[:-1] + cuts[1:])
-    block = np.empty(len(mid), dtype=np.intp)
-    block_indices(geo.s_start_mm, mid, block)  # geo.block_at, a pass for the sorted mids
+    block = geo.block_at_ordered(mid)
     speed = p.feed_mm_s[block].copy()
     if zone.any():
         speed = np.minimum(speed, _fir_loops.range_min(len(mid), i_lo, i_hi, v[zone]))
@@ -422,8 +420,7 @@ def _arc_refinement(tp: Toolpath, geo: PathGeometry, cmd: _Command):
     if not len(ds):
         return None
     mid = 0.5 * (s_knots[:-1] + s_knots[1:])
-    b = np.empty(len(mid), dtype=np.intp)
-    block_indices(geo.s_start_mm, mid, b)
+    b = geo.block_at_ordered(mid)
     r = np.where(tp.is_arc[b], tp.radius_mm[b], np.inf)
     r = np.where(r > 0, r, np.inf)
     # chord of angle dphi deviates r (1 - cos(dphi / 2)) ~ r dphi^2 / 8 from the arc
