@@ -523,17 +523,17 @@ def fit_planner(
             axis_max_velocity_mm_s=tuple(float(v) for v in e[3:]),
         )
 
-    def residual(x: np.ndarray) -> np.ndarray:
-        m = profile(x)
-        planned = np.array(
-            [blend_planner(tp, m, stop_periods="mean").cycle_time_s for tp, _ in programs]
+    def planned_s(m: MachineProfile, stop_periods: str) -> np.ndarray:
+        return np.array(
+            [blend_planner(tp, m, stop_periods=stop_periods).cycle_time_s for tp, _ in programs]
         )
-        return np.log(planned / measured)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        return np.log(planned_s(profile(x), "mean") / measured)
 
     fit = least_squares(residual, x0, bounds=(lower, upper), diff_step=1e-3, method="trf")
     fitted = profile(fit.x)
-    planned = np.array([blend_planner(tp, fitted).cycle_time_s for tp, _ in programs])
-    err = 100 * np.abs(planned / measured - 1)
+    err = 100 * np.abs(planned_s(fitted, "whole") / measured - 1)
     limits = pd.DataFrame(
         [{"axis": axis, "limit": limit, "start": s, "fitted": getattr(fitted, field)[i],
           "profile": getattr(machine, field)[i]}
