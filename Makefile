@@ -147,9 +147,9 @@ linuxcnc:
 	fi; \
 	echo "linuxcnc: ready in $$(( $$(date +%s) - t0 )) s"
 
-# record: the shipped LinuxCNC recordings (nctwin.recordings), re-recorded from nothing.
+# record: the shipped LinuxCNC recordings (nctwin.record), re-recorded from nothing.
 record: venv linuxcnc
-	@t0=$$(date +%s); $(PY) -m nctwin.recordings; \
+	@t0=$$(date +%s); $(PY) -m nctwin.record; \
 	echo "record: done in $$(( $$(date +%s) - t0 )) s"
 
 # ---------------------------------------------------------------------------------------------
@@ -204,17 +204,8 @@ unit: venv
 # nbval re-executes the notebooks in the environment papermill executed them in (inline figures,
 # no progress bars on stderr): a checked cell whose training outlasts the bar's delay would
 # otherwise print to stderr, which its executed copy does not have.
-# Chapters whose checked tables include the public programs of ../shared/programs (not shipped):
-# nbval skips them where those programs are not beside the clone.
-NEEDS_PUBLIC    := book/notebooks/linuxcnc_real_kernel.ipynb
-PUBLIC_PROGRAMS ?= ../shared/programs
 nbval: venv | $(EXECUTED)
 	@shopt -s nullglob; nbs=(book/notebooks/*.ipynb); \
-	if [ ! -d "$(PUBLIC_PROGRAMS)" ]; then \
-	  echo "nbval: $(PUBLIC_PROGRAMS) is absent: not checking $(NEEDS_PUBLIC)"; \
-	  keep=(); for nb in "$${nbs[@]}"; do case " $(NEEDS_PUBLIC) " in *" $$nb "*) ;; *) keep+=("$$nb");; esac; done; \
-	  nbs=("$${keep[@]}"); \
-	fi; \
 	if [ $${#nbs[@]} -eq 0 ]; then echo "nbval: book/notebooks/ holds no executed notebook; skipped"; exit 0; fi; \
 	echo "nbval: $${nbs[*]}"; \
 	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env -p no:cacheprovider "$${nbs[@]}"

@@ -8,13 +8,13 @@ import numpy as np
 import torch
 from _common import best_time_s, record
 
-from nctwin import chien2023 as ch
 from nctwin import gcode
-from nctwin.features import chien2023_features
-from nctwin.models import ModelConfig, build
+from nctwin.chapters import chien2023 as ch
+from nctwin.learn.models import ModelConfig, build
+from nctwin.learn.train import Scaler, TrainConfig, Trained
+from nctwin.methods.chien2023 import features as chien2023_features
 from nctwin.programs.pocket import pocket_program
 from nctwin.toolpath import Toolpath
-from nctwin.train import Scaler, TrainConfig, Trained
 
 
 def main() -> None:

@@ -2,7 +2,8 @@
 10,000-line ``contour.ngc``.
 
 Targets: at least 10 million output samples per second; the pocket in under 0.3 s. The
-throughput is end to end: output samples over the wall time of ``fir.run(toolpath, machine)``
+throughput is end to end: output samples over the wall time of
+``fir.run(toolpath, machine, settings)``
 (planning included), best of 5, each run on a fresh copy of the parsed tool path so that no
 property the tool path caches (lengths, tangents) is reused between runs. Per stage, on the
 pocket: ``kernel_pocket5000_plan_s`` times the look-ahead (``fir.plan``) alone,
@@ -47,25 +48,26 @@ def cold_time_s(fn: Callable[[Toolpath], object], toolpath: Toolpath) -> float:
 
 def main() -> None:
     machine = load_machine("paper1_sim")
+    settings = fir.FirSettings.load("paper1_sim")
     # the pocket: about 5000 G-lines and 220 s of motion; at the programmed 50 mm/s
     # the package's pocket runs 4682 lines in 214.5 s (at its default 92 mm/s, 123 s)
     pocket = parse(pocket_program(feed_mm_s=POCKET_FEED_MM_S, tol_mm=0.3))
-    samples = len(fir.run(pocket, machine))
-    t = cold_time_s(lambda tp: fir.run(tp, machine), pocket)
+    samples = len(fir.run(pocket, machine, settings))
+    t = cold_time_s(lambda tp: fir.run(tp, machine, settings), pocket)
     record("kernel_pocket5000_s", round(t, 4), "s", "< 0.3")
-    tplan = cold_time_s(lambda tp: fir.plan(tp, machine), pocket)
+    flt = fir.FirFilter.of(settings, machine.period_s)
+    tplan = cold_time_s(lambda tp: fir.plan(tp, machine, flt), pocket)
     record("kernel_pocket5000_plan_s", round(tplan, 4), "s", "")
     record("kernel_sample_stage_samples_per_s", round(samples / (t - tplan)), "samples/s", "")
-    x = fir.run(pocket, machine).pos_mm.T.copy()  # (3, n) samples to filter
-    flt = fir.FirFilter.of(machine)
+    x = fir.run(pocket, machine, settings).pos_mm.T.copy()  # (3, n) samples to filter
     tf = best_time_s(lambda: flt.apply(x), repeat=REPEAT, warmup=1)
     record("kernel_filter_samples_per_s", round(x.shape[1] / tf), "samples/s", ">= 1e7")
     total_samples, total_time = samples, t
     contour = SHARED_PROGRAMS / "contour.ngc"
     if contour.exists():
         tp = parse_file(contour)
-        n = len(fir.run(tp, machine))
-        tc = cold_time_s(lambda tp: fir.run(tp, machine), tp)
+        n = len(fir.run(tp, machine, settings))
+        tc = cold_time_s(lambda tp: fir.run(tp, machine, settings), tp)
         record("kernel_contour_samples_per_s", round(n / tc), "samples/s", ">= 1e7")
         record("kernel_contour_blocks_per_s", round(len(tp) / tc), "blocks/s", "")
         total_samples += n

@@ -6,7 +6,8 @@ points, 19,800 CL segments, R = 5 mm), three ways:
 * ``step_error_iterative_s``: the per-segment Brent loop, timed on every 20th segment and scaled
   to 19,800 (no target: the baseline);
 * ``step_error_nn_inference_s``: the BP network (325 -> 28 -> 20 -> 1) predicting 19,800 Table 1
-  samples with :func:`nctwin.zhang2023.predict_um`, the chapter's prediction: from the inputs,
+  samples with :func:`nctwin.chapters.zhang2023.predict_um`, the chapter's prediction: from the
+  inputs,
   already built (float64, (19,800, 325)), and the model, already loaded, to the step errors in
   um (Z-score folded into the first layer, forward pass, back-scaling), one torch thread
   (target < 0.05 s; the paper: 2.86 s with model import, on a GPU). Building the inputs from
@@ -26,16 +27,16 @@ import numpy as np
 import torch
 from _common import best_time_s, record
 
-from nctwin.models import BPConfig, build_bp
-from nctwin.steperror import (
+from nctwin.chapters.zhang2023 import predict_um
+from nctwin.learn.models import BPConfig, build_bp
+from nctwin.learn.train import Scaler, TrainConfig, Trained
+from nctwin.physics.steperror import (
     inner_points_for_hidden_width,
     step_error_iterative_um,
     step_error_samples,
     step_error_um,
 )
-from nctwin.surfaces import iso_parametric_path, paper_surface
-from nctwin.train import Scaler, TrainConfig, Trained
-from nctwin.zhang2023 import predict_um
+from nctwin.physics.surfaces import iso_parametric_path, paper_surface
 
 
 def main() -> None:

@@ -12,17 +12,15 @@ from nctwin.estimate.blend_planner import (
     KINK_RATIO,
     MIN_SEGMENT_CYCLES,
     NORMAL_ACC_RATIO,
-    OPTIMIZATION_DEPTH,
     STOP_TURN_RAD,
     blend_plane_acc,
     blend_planner,
     junction_blends,
     move_limits,
-    optimised_end_speeds,
     parabolic_junctions,
-    stops_on_periods,
     tangent_junctions,
 )
+from nctwin.estimate.blend_speeds import OPTIMIZATION_DEPTH, optimised_end_speeds, stops_on_periods
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
 

@@ -14,8 +14,9 @@ from test_accdec import MACHINE, _program, segment
 
 from nctwin import parse
 from nctwin.estimate import METHODS, estimate
-from nctwin.estimate.block_overlap import block_overlap, block_times
+from nctwin.estimate.block_overlap import block_overlap
 from nctwin.kernel.accdec import simulate
+from nctwin.methods.lee2022 import block_times
 
 TI = MACHINE.period_s  # 1 ms
 AT, ATR, AS = 0.05, 0.15, 0.03

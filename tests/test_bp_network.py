@@ -8,8 +8,8 @@ import pytest
 import torch
 
 from nctwin import paths
-from nctwin.models import BPConfig, BPNetwork, build_bp
-from nctwin.train import TrainConfig, fit, load_checkpoint
+from nctwin.learn.models import BPConfig, BPNetwork, build_bp
+from nctwin.learn.train import TrainConfig, fit, load_checkpoint
 
 
 @pytest.fixture(autouse=True)
@@ -104,7 +104,7 @@ def test_dropout_training_repeats_bit_for_bit_and_leaves_the_global_rng_alone() 
 
 
 def test_a_diverging_training_raises_a_clear_error() -> None:
-    from nctwin.train import TrainingDivergedError
+    from nctwin.learn.train import TrainingDivergedError
 
     xs, ys = _rows()
     config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.0, weight_init="normal",

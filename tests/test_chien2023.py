@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
-from nctwin import chien2023 as ch
 from nctwin import gcode
+from nctwin.chapters import chien2023 as ch
 from nctwin.kernel import fir
 from nctwin.machine import load_machine
+from nctwin.paths import cache_dir
 from nctwin.programs.training import global_program, mixed_program
 
 MACHINE_B = load_machine("paper1_machine_b")
@@ -14,7 +15,7 @@ MACHINE_B = load_machine("paper1_machine_b")
 
 def test_recorded_labels_follow_the_lagging_axes():
     tp = ch.cutting_blocks(gcode.parse("G21 G90 G64 P0.1\nG1 X50 F4200\nY50\n"))
-    motion = fir.run(tp, MACHINE_B)
+    motion = fir.run(tp, MACHINE_B, fir.FirSettings.load("paper1_machine_b"))
     rec = ch.Recording(position_gain_1_s=40.0).apply(motion, np.random.default_rng(0))
     switch = np.flatnonzero(np.diff(motion.block))[0]
     # the discrete loop follows a ramp 1 / (1 - exp(-Kv Ts)) = 25.5 samples late (1 / Kv = 25 ms)
@@ -54,15 +55,15 @@ def test_noise_alone_leaves_the_times_almost_unchanged():
 def test_time_by_length_splits_the_cycle_time():
     import torch
 
-    from nctwin.models import ModelConfig, build
-    from nctwin.train import Scaler, TrainConfig, Trained
+    from nctwin.learn.models import ModelConfig, build
+    from nctwin.learn.train import Scaler, TrainConfig, Trained
 
     machine = load_machine("paper1_sim")
     run = ch.simulate_one(mixed_program(7, n_lines=200, feed_mm_s=80.0, tol_mm=0.3), machine)
     model = build(ModelConfig("bilstm", n_outputs=2), generator=torch.Generator().manual_seed(0))
     trained = Trained(model, Scaler.fit([run.features], log_columns=[1]),
                       Scaler(np.zeros(2), np.ones(2)), TrainConfig(), {}, 0, 0.0,
-                      ch.paths.cache_dir())  # fmt: skip
+                      cache_dir())  # fmt: skip
     row = ch.time_by_length({("p", 80.0, 0.3): run}, trained).iloc[0]
     assert row.short_lines + row.long_lines == len(run.features)
     assert row.long_lines >= 1

@@ -38,7 +38,7 @@ def test_estimate_json(program, capsys):
     assert data["cycle_time_s"] == pytest.approx(5 / 200 + 3.5)
 
 
-def test_estimate_default_method_is_the_profiles(program, capsys):
+def test_estimate_default_method_is_the_chapters(program, capsys):
     # linuxcnc_sim defaults to its chapter's best method, the blend-arc planner.
     # LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2, 2 sqrt(5 / 500) =
     # 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners (0.0254 mm

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from nctwin import cutting
+from nctwin.physics import cutting
 
 TOOL = cutting.EndMill(runout_mm=0.0)
 C = cutting.C45

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from nctwin import drives
+from nctwin.physics import drives
 
 MACHINE = drives.FeedDriveMachine()
 

@@ -11,9 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from nctwin import parse
-from nctwin.features import block_targets
 from nctwin.kernel import fir
 from nctwin.machine import MachineProfile
+from nctwin.targets import block_targets
 
 MACHINE = MachineProfile(
     name="fir-test",
@@ -25,10 +25,9 @@ MACHINE = MachineProfile(
     max_feed_mm_s=1000.0,
     period_s=0.001,
     blend_tol_mm=0.05,
-    fir_t1_s=0.05,
-    fir_t2_s=0.01,
 )
-FILTER = fir.FirFilter.of(MACHINE)
+SETTINGS = fir.FirSettings(t1_s=0.05, t2_s=0.01)
+FILTER = fir.FirFilter.of(SETTINGS, MACHINE.period_s)
 
 
 def _corner_distance(pos: np.ndarray, corner) -> float:
@@ -42,8 +41,8 @@ def _corner_distance(pos: np.ndarray, corner) -> float:
 
 def test_straight_line_takes_l_over_f_plus_t1_plus_t2():
     feed, length = 80.0, 120.0
-    motion = fir.run(parse(f"G1 X{length} F{feed * 60}"), MACHINE)
-    expected = length / feed + MACHINE.fir_t1_s + MACHINE.fir_t2_s
+    motion = fir.run(parse(f"G1 X{length} F{feed * 60}"), MACHINE, SETTINGS)
+    expected = length / feed + SETTINGS.t1_s + SETTINGS.t2_s
     assert motion.cycle_time_s == pytest.approx(expected, abs=MACHINE.period_s)
     np.testing.assert_array_equal(motion.pos_mm[0], [0, 0, 0])
     np.testing.assert_array_equal(motion.pos_mm[-1], [length, 0, 0])
@@ -51,16 +50,16 @@ def test_straight_line_takes_l_over_f_plus_t1_plus_t2():
     # acceleration F / T1 and jerk F / (T1 T2), within the rounding of differences
     acc = np.abs(motion.acc_mm_s2[:, 0]).max()
     jerk = np.abs(motion.jerk_mm_s3[:, 0]).max()
-    assert acc <= feed / MACHINE.fir_t1_s * (1 + 1e-6)
-    assert acc == pytest.approx(feed / (MACHINE.fir_t1_s + MACHINE.period_s), rel=1e-6)
-    assert jerk <= feed / (MACHINE.fir_t1_s * MACHINE.fir_t2_s) * (1 + 1e-6)
+    assert acc <= feed / SETTINGS.t1_s * (1 + 1e-6)
+    assert acc == pytest.approx(feed / (SETTINGS.t1_s + MACHINE.period_s), rel=1e-6)
+    assert jerk <= feed / (SETTINGS.t1_s * SETTINGS.t2_s) * (1 + 1e-6)
 
 
 def test_filter_taps_span_the_time_constants():
     n1, n2 = FILTER.taps
     assert (n1, n2) == (51, 11)
     assert FILTER.weights.sum() == pytest.approx(1.0)
-    assert FILTER.length_s == pytest.approx(MACHINE.fir_t1_s + MACHINE.fir_t2_s)
+    assert FILTER.length_s == pytest.approx(SETTINGS.t1_s + SETTINGS.t2_s)
 
 
 @pytest.mark.parametrize("t2_s", [0.0, 0.01])
@@ -96,8 +95,8 @@ def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0
     tp = parse(f"G64 P5 G1 X50 F{feed * 60}\nY50")
-    assert fir.plan(tp, MACHINE).junction_mm_s[1] == pytest.approx(feed)
-    d = _corner_distance(fir.run(tp, MACHINE).pos_mm, np.array([50.0, 0, 0]))
+    assert fir.plan(tp, MACHINE, FILTER).junction_mm_s[1] == pytest.approx(feed)
+    d = _corner_distance(fir.run(tp, MACHINE, SETTINGS).pos_mm, np.array([50.0, 0, 0]))
     # the sampled boxes average n = T/Ts + 1 samples: their continuous twins are n Ts long
     n1, n2 = FILTER.taps
     ts = MACHINE.period_s
@@ -116,17 +115,17 @@ def test_reduced_corner_is_within_tolerance_at_the_highest_feed(angle_deg):
     end = corner + 50.0 * np.array([math.cos(a), math.sin(a), 0.0])
     program = f"G1 X50 F{feed * 60}\nX{end[0]:.9f} Y{end[1]:.9f}"
     tp = parse(f"G64 P{tol}\n{program}")
-    v = fir.plan(tp, MACHINE).junction_mm_s[1]
+    v = fir.plan(tp, MACHINE, FILTER).junction_mm_s[1]
     assert 0 < v < feed  # reduced
-    assert _corner_distance(fir.run(tp, MACHINE).pos_mm, corner) <= tol
+    assert _corner_distance(fir.run(tp, MACHINE, SETTINGS).pos_mm, corner) <= tol
     # one percent faster through the same corner breaks the tolerance
     faster = parse(f"G64 P5\nG1 X50 F{v * 1.01 * 60}\nX{end[0]:.9f} Y{end[1]:.9f}")
-    assert _corner_distance(fir.run(faster, MACHINE).pos_mm, corner) > tol
+    assert _corner_distance(fir.run(faster, MACHINE, SETTINGS).pos_mm, corner) > tol
 
 
 def test_exact_stop_and_dwell():
     tp = parse("G61 G1 X10 F600\nY10\nG4 P0.5\nX0")
-    motion = fir.run(tp, MACHINE)
+    motion = fir.run(tp, MACHINE, SETTINGS)
     stops = np.flatnonzero(motion.speed_mm_s == 0)
     # the tool stands still at the corner (G61) and for the dwell
     at_corner = np.linalg.norm(motion.pos_mm - [10, 0, 0], axis=1) < 1e-9
@@ -148,7 +147,7 @@ def test_short_segments_on_a_circle_keep_the_feed_high():
         f"G1 X{x:.6f} Y{y:.6f}" for x, y in pts
     )
     tp = parse(program)
-    motion = fir.run(tp, MACHINE)
+    motion = fir.run(tp, MACHINE, SETTINGS)
     middle = (motion.block > 200) & (motion.block < 800)
     assert np.median(motion.speed_mm_s[middle]) >= 0.95 * feed
     assert motion.speed_mm_s[middle].min() >= 0.9 * feed
@@ -162,9 +161,9 @@ def test_zigzag_dips_at_every_corner():
     tp = parse(
         "G64 P0.05\nF%g\n" % (feed * 60) + "\n".join(f"G1 X{x:.6f} Y{y:.6f}" for x, y in pts)
     )
-    plan = fir.plan(tp, MACHINE)
+    plan = fir.plan(tp, MACHINE, FILTER)
     assert (plan.junction_mm_s[1:n] < 0.5 * feed).all()
-    motion = fir.run(tp, MACHINE)
+    motion = fir.run(tp, MACHINE, SETTINGS)
     targets = block_targets(motion, tp)
     at_corners = motion.speed_mm_s[targets.junction_sample[1:n]]
     assert (at_corners < 0.5 * feed).all()
@@ -172,14 +171,14 @@ def test_zigzag_dips_at_every_corner():
 
 def test_kernel_cycle_time_exceeds_cam():
     tp = parse("G1 X10 F6000\nY10\nX0\nY0")
-    motion = fir.run(tp, MACHINE)
+    motion = fir.run(tp, MACHINE, SETTINGS)
     assert motion.cycle_time_s > 40.0 / 100.0 + FILTER.length_s
 
 
 def test_bad_filter_constants_are_named():
-    slow = dataclasses.replace(MACHINE, fir_t1_s=0.0, fir_t2_s=0.0)
-    with pytest.raises(ValueError, match=r"fir_t1_s = 0.0 is out of range for the FIR kernel"):
-        fir.run(parse("G1 X1 F60"), slow)
+    slow = fir.FirSettings(t1_s=0.0, t2_s=0.0)
+    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range for the FIR kernel"):
+        fir.run(parse("G1 X1 F60"), MACHINE, slow)
 
 
 # ------------------------------------------------------------------------------ properties
@@ -213,7 +212,7 @@ def programs(draw) -> str:
 @given(programs())
 def test_kernel_invariants(program):
     tp = parse(program)
-    motion = fir.run(tp, LIMITED)
+    motion = fir.run(tp, LIMITED, SETTINGS)
     np.testing.assert_array_equal(motion.pos_mm[-1], tp.end_mm[-1])
     np.testing.assert_array_equal(motion.pos_mm[0], tp.start_mm[0])
     assert np.isfinite(motion.pos_mm).all()
@@ -238,8 +237,8 @@ def test_arc_feed_is_limited_by_centripetal_acceleration():
     )
     tp = parse("G0 X5 Y0\nG3 X5 Y0 I-5 J0 F30000")
     v_arc = math.sqrt(2000.0 * 5.0)
-    assert fir.plan(tp, tight).feed_mm_s[1] == pytest.approx(v_arc)
-    motion = fir.run(tp, tight)
+    assert fir.plan(tp, tight, FILTER).feed_mm_s[1] == pytest.approx(v_arc)
+    motion = fir.run(tp, tight, SETTINGS)
     on_arc = motion.block == 1
     assert motion.speed_mm_s[on_arc].max() <= v_arc * (1 + 1e-9)
     # the tool stays on the circle within the filter's shrinkage

@@ -4,7 +4,7 @@ has the model's own form."""
 import numpy as np
 import pytest
 
-from nctwin import force_model as fm
+from nctwin.methods import denkena2020 as fm
 
 
 def test_friction_fit_recovers_its_own_parameters():

@@ -84,3 +84,21 @@ def test_toml_errors(tmp_path):
         load_machine(broken)
     with pytest.raises(ValueError, match="machine = 'nope' is unknown: allowed"):
         load_machine("nope")
+
+
+def test_a_profile_missing_keys_names_them(tmp_path):
+    p = tmp_path / "bad.toml"
+    p.write_text('description = "x"\nrapid_feed_mm_s = 100.0\n')
+    with pytest.raises(ValueError, match=r"bad.toml: missing field\(s\) axis_max_velocity_mm_s"):
+        load_machine(p)
+
+
+def test_fir_settings_live_apart_from_the_profile():
+    from nctwin.kernel.fir import FirSettings
+
+    assert FirSettings.load("paper1_sim") == FirSettings(t1_s=0.08, t2_s=0.02)
+    assert FirSettings.load("fanuc_0i_testbed") == FirSettings()  # no [fir] table
+    with pytest.raises(ValueError, match=r"blend_ratio = 2.0 is out of range: allowed \(0, 1\]"):
+        FirSettings(blend_ratio=2.0)
+    with pytest.raises(ValueError, match=r"block_periods = 1.5 is out of range"):
+        FirSettings(block_periods=1.5)

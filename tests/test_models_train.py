@@ -5,8 +5,8 @@ import pytest
 import torch
 
 from nctwin import paths
-from nctwin.models import ModelConfig, build
-from nctwin.train import Scaler, TrainConfig, _split, fit, load_checkpoint
+from nctwin.learn.models import ModelConfig, build
+from nctwin.learn.train import Scaler, TrainConfig, _split, fit, load_checkpoint
 
 
 @pytest.fixture(autouse=True)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from nctwin import chien2023 as ch
 from nctwin import gcode
+from nctwin.chapters import chien2023 as ch
 from nctwin.programs.pocket import BAND_MM, OUTLINE_MM, pocket_program, pocket_rings
 
 TOOL_R = 4.0

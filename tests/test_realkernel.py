@@ -1,5 +1,6 @@
-"""The chapter "Predicting a real controller" (nctwin.realkernel): moves, features and LinuxCNC's
-rules, checked on programs small enough to work out by hand."""
+"""The chapter "Predicting a real controller" (nctwin.chapters.linuxcnc, nctwin.estimate.learned,
+nctwin.identify): moves, features and LinuxCNC's rules, checked on programs small enough to work
+out by hand."""
 
 import dataclasses
 import math
@@ -8,26 +9,30 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin import realkernel as rk
-from nctwin.estimate import estimate
-from nctwin.features import BlockTargets
+from nctwin import identify
+from nctwin.chapters import linuxcnc as rk
+from nctwin.estimate import best_method, default_method, estimate, learned
+from nctwin.estimate.kernel import fir_settings
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
 from nctwin.paths import results_dir
 from nctwin.recordings import RecordedProgram
+from nctwin.targets import BlockTargets
 
 MACHINE = load_machine("linuxcnc_sim")  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
 
 
 def col(name: str) -> int:
-    return rk.FEATURES.index(name)
+    return learned.FEATURES.index(name)
 
 
 def test_arc_becomes_chords_on_the_arc():
     # a quarter circle of radius 10 mm: 1.571 rad, 15.7 mm -> 16 chords of at most 1 mm
     tp = parse("G21 G90 G17\nG1 X10 F600\nG3 X0 Y10 I-10 J0\nG1 X-5\n", start_mm=(0, 0, 0))
-    moves, source = rk.model_blocks(tp)
-    pieces = math.ceil(max(math.pi / 2 / rk.ARC_CHORD_RAD, 10 * math.pi / 2 / rk.ARC_CHORD_MM))
+    moves, source = learned.model_blocks(tp)
+    pieces = math.ceil(
+        max(math.pi / 2 / learned.ARC_CHORD_RAD, 10 * math.pi / 2 / learned.ARC_CHORD_MM)
+    )
     assert len(moves) == 2 + pieces
     assert (moves.kind == 1).all()  # all linear
     np.testing.assert_array_equal(source, [0] + [1] * pieces + [2])
@@ -41,7 +46,7 @@ def test_arc_becomes_chords_on_the_arc():
 
 def test_dwells_and_zero_moves_are_not_moves():
     tp = parse("G21 G90\nG1 X10 F600\nG4 P0.5\nG1 X10\nG1 X20\n", start_mm=(0, 0, 0))
-    data = rk.move_data("p", tp, MACHINE)
+    data = learned.move_data("p", tp, MACHINE)
     assert len(data.moves) == 2
     assert data.dwell_s == 0.5
 
@@ -49,13 +54,13 @@ def test_dwells_and_zero_moves_are_not_moves():
 def test_feed_is_clipped_to_axes_and_control():
     # X at F 30000 mm/min (500 mm/s) -> 200; Z alone at 150 mm/s -> Z's 100; rapid -> 200
     tp = parse("G21 G90\nG1 X10 F30000\nG1 Z10 F9000\nG0 X0\n", start_mm=(0, 0, 0))
-    x = rk.features(rk.model_blocks(tp)[0], MACHINE)
+    x = learned.features(learned.model_blocks(tp)[0], MACHINE)
     np.testing.assert_allclose(x[:, col("feed_mm_s")], [200.0, 100.0, 200.0])
 
 
 def test_path_acceleration_along_the_move():
     tp = parse("G21 G90\nG1 X10 F600\nG1 X20 Y10\nG1 Z10\n", start_mm=(0, 0, 0))
-    acc = rk.features(rk.model_blocks(tp)[0], MACHINE)[:, col("acc_mm_s2")]
+    acc = learned.features(learned.model_blocks(tp)[0], MACHINE)[:, col("acc_mm_s2")]
     np.testing.assert_allclose(acc, [1000.0, 1000.0 * math.sqrt(2), 500.0])
 
 
@@ -66,13 +71,13 @@ def test_path_acceleration_along_the_move():
         ("G64 P0.1", 0.1, 0.1),  # P without Q: Q = P
         ("G64 P0.1 Q0", 0.1, 0.0),
         ("G64 P0.1 Q0.01", 0.1, 0.01),
-        ("G64", rk.TOL_CAP_MM, 0.0),  # no tolerance
+        ("G64", learned.TOL_CAP_MM, 0.0),  # no tolerance
         ("G61", 0.0, 0.0),
     ],
 )
 def test_linuxcnc_tolerance_rules(g64, tol, naive):
     tp = parse(f"G21 G90\n{g64}\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
-    x = rk.features(rk.model_blocks(tp)[0], MACHINE)
+    x = learned.features(learned.model_blocks(tp)[0], MACHINE)
     np.testing.assert_allclose(x[:, col("tol_mm")], tol)
     np.testing.assert_allclose(x[:, col("naive_tol_mm")], naive)
 
@@ -81,7 +86,7 @@ def test_targets_from_block_targets():
     # two lines of 10 mm at 10 mm/s: measured 1.5 s and 1.25 s over 9.9 and 10 mm
     tp = parse("G21 G90\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
     bt = BlockTargets(np.array([0, 1500, 2750]), np.array([9.9, 10.0]), np.array([1.5, 1.25]))
-    d = rk.move_data("p", tp, MACHINE, bt)
+    d = learned.move_data("p", tp, MACHINE, bt)
     np.testing.assert_allclose(d.targets[:, 0], [9.9 / 1.5, 10 / 1.25])
     np.testing.assert_allclose(d.targets[:, 1], np.log([1.5, 1.25]))  # ln(F t / l)
     np.testing.assert_allclose(d.axis_targets, [[9.9 / 1.5, 0, 0], [0, 8.0, 0]])
@@ -91,13 +96,13 @@ def test_targets_from_block_targets():
 def test_block_overlap_constants_from_acceleration():
     # main cutting feed 100 mm/s (the longer cut) -> A_T = 100 / 1000 = 0.1 s; A_TR = 0.2 s
     tp = parse("G21 G90\nG1 X100 F6000\nG1 Y10 F1200\n", start_mm=(0, 0, 0))
-    m = rk.identified_block_overlap_machine(tp, MACHINE)
+    m = identify.identified_block_overlap_machine(tp, MACHINE)
     assert m.cut_time_constant_s == pytest.approx(0.1)
     assert m.rapid_time_constant_s == pytest.approx(0.2)
     assert m.inposition_time_s == (0.0, 0.0, 0.0)
     # a single line: L/F + A_T, LinuxCNC's L/F + F/A
     line = parse("G21 G90\nG1 X100 F6000\n", start_mm=(0, 0, 0))
-    lee = rk.identified_block_overlap_machine(line, MACHINE)
+    lee = identify.identified_block_overlap_machine(line, MACHINE)
     assert estimate(line, lee, "block_overlap").cycle_time_s == pytest.approx(1.0 + 0.1)
 
 
@@ -107,14 +112,17 @@ def test_learned_methods_need_recordings():
         estimate(tp, load_machine("paper1_sim"), "bilstm")
 
 
-def test_profile_carries_the_chapters_fit_and_best_method():
-    # linuxcnc_sim's FIR stand-in settings and default method are the chapter's results
+def test_estimates_read_the_chapters_fit_and_best_method():
+    # linuxcnc_sim's FIR stand-in settings and default method are the chapter's results, read
+    # from its files, not written into the profile
     results = results_dir() / "linuxcnc_real_kernel"
     best = pd.read_csv(results / "fir_fit.csv").iloc[0]  # sorted by score
-    for field in rk.FIR_FIELDS:
-        assert getattr(MACHINE, field) == pytest.approx(best[field])
+    settings = fir_settings(MACHINE)
+    for field in identify.FIR_FIELDS:
+        assert getattr(settings, field.removeprefix("fir_")) == pytest.approx(best[field])
     summary = pd.read_csv(results / "summary.csv")
-    assert MACHINE.default_method == rk.best_method(summary)
+    assert default_method(MACHINE) == best_method(summary) == "planner"
+    assert default_method(load_machine("paper1_sim")) == "cam"
 
 
 def _recording(name: str, program: str, time_s: float, source: str = "nctwin") -> RecordedProgram:
@@ -201,7 +209,7 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
     for text in texts:
         tp = parse(text, start_mm=(0, 0, 0))
         programs.append((tp, estimate(tp, truth, "planner").cycle_time_s))
-    fit = rk.fit_planner(programs, MACHINE)
+    fit = identify.fit_planner(programs, MACHINE)
     # the "recordings" stop on whole 1 ms periods, the fit plans half a period per stop: the
     # limits come back within a few tenths of a percent
     np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=5e-3)
@@ -213,8 +221,8 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
 def test_fit_planner_rejects_bad_input():
     tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
     with pytest.raises(ValueError, match="programs is empty"):
-        rk.fit_planner([], MACHINE)
+        identify.fit_planner([], MACHINE)
     with pytest.raises(ValueError, match="allowed > 0"):
-        rk.fit_planner([(tp, 0.0)], MACHINE)
+        identify.fit_planner([(tp, 0.0)], MACHINE)
     with pytest.raises(ValueError, match=r"start = \(500.0, 400.0\) is out of range"):
-        rk.fit_planner([(tp, 1.0)], MACHINE, start=(500.0, 400.0))
+        identify.fit_planner([(tp, 1.0)], MACHINE, start=(500.0, 400.0))

@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from nctwin import recordings
+from nctwin import record, recordings
 from nctwin.gcode import parse
 from nctwin.machine import load_machine
 from nctwin.toolpath import MotionKind
@@ -26,7 +26,7 @@ LIVE = sorted(OWN, key=lambda name: SHIPPED[name].n_samples)[:2]
 
 
 def test_shipped_set_is_the_specified_set():
-    programs = recordings.recording_programs()
+    programs = record.recording_programs()
     assert OWN == sorted(programs)
     for name, text in programs.items():
         assert SHIPPED[name].program == text
@@ -54,7 +54,7 @@ def test_public_program_absent_or_changed(tmp_path):
 
 def test_public_program_nctwin_rejects_needs_no_linuxcnc(tmp_path):
     (tmp_path / "bad.ngc").write_text("G1 X#1\n")
-    recorded, rejected = recordings.record_public(tmp_path, tmp_path / "out")
+    recorded, rejected = record.record_public(tmp_path, tmp_path / "out")
     assert recorded == [] and list(rejected) == ["bad.ngc"]
     assert "bad.ngc:1:" in rejected["bad.ngc"]
     saved = json.loads((tmp_path / "out" / recordings.PUBLIC_REJECTED).read_text())
@@ -105,7 +105,7 @@ def test_shipped_recording_is_consistent(name):
 @pytest.mark.parametrize("name", LIVE)
 def test_live_recording_equals_shipped(name):
     shipped = SHIPPED[name]
-    live = recordings.record_program(name, shipped.program, MACHINE)
+    live = record.record_program(name, shipped.program, MACHINE)
     assert live.n_samples == shipped.n_samples
     assert live.trace_sha256 == shipped.trace_sha256
     np.testing.assert_array_equal(live.targets.junction_sample, shipped.targets.junction_sample)

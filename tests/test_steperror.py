@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from nctwin.steperror import (
+from nctwin.physics.steperror import (
     chord_step_error_um,
     inner_points_for_hidden_width,
     sample_columns,
@@ -18,8 +18,14 @@ from nctwin.steperror import (
     step_error_samples,
     step_error_um,
 )
-from nctwin.surfaces import BumpSurface, Cylinder, Sphere, iso_parametric_path, paper_surface
-from nctwin.tables import load_paper_table
+from nctwin.physics.surfaces import (
+    BumpSurface,
+    Cylinder,
+    Sphere,
+    iso_parametric_path,
+    paper_surface,
+)
+from nctwin.report.tables import load_paper_table
 
 TOL_UM = 1e-6  # the accuracy the exact method promises
 

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from nctwin import parse
-from nctwin.features import SUN2022_FEATURES, sun2022_features
-from nctwin.models import ModelConfig, build
+from nctwin.learn.models import ModelConfig, build
+from nctwin.methods.sun2022 import FEATURES as SUN2022_FEATURES
+from nctwin.methods.sun2022 import features as sun2022_features
 
 
 def test_features_by_hand():
@@ -58,8 +59,8 @@ class _Constant:
 
 
 def test_eq9_eq10_by_hand():
+    from nctwin.chapters.sun2022 import oracle_time, predict_time, run_pocket
     from nctwin.machine import load_machine
-    from nctwin.sun2022 import oracle_time, predict_time, run_pocket
 
     run = run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_machine("sun2022_siemens"))
     # axis feeds (3, 4, 0) give a resultant of 5 mm/s (eq. 9): 70 mm take 14 s (eq. 10)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from nctwin.surfaces import (
+from nctwin.physics.surfaces import (
     PAPER_SURFACES,
     BumpSurface,
     Cylinder,
@@ -14,7 +14,7 @@ from nctwin.surfaces import (
     iso_parametric_path,
     paper_surface,
 )
-from nctwin.tables import load_paper_table
+from nctwin.report.tables import load_paper_table
 
 PAPER = load_paper_table("zhang2023_surfaces").set_index("surface")
 

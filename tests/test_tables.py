@@ -1,4 +1,4 @@
-"""Tests of nctwin.tables: errors, joins, claims, atomic results files, and the paper CSVs."""
+"""nctwin.report.tables: errors, joins, claims, atomic results files, and the paper CSVs."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin import tables
-from nctwin.tables import (
+from nctwin.report import tables
+from nctwin.report.tables import (
     Claim,
     UnknownTableError,
     accuracy_pct,

@@ -8,7 +8,7 @@ import pytest
 from nctwin import MotionKind, parse
 from nctwin.kernel import fir
 from nctwin.machine import load_machine
-from nctwin.measure import controller_samples, nearest_sample
+from nctwin.physics.measure import controller_samples, nearest_sample
 from nctwin.programs.thinwall import HOME_MM, POCKETS, thinwall_programs
 
 
@@ -45,7 +45,7 @@ def test_programs_are_deterministic():
 
 def test_controller_samples_rate_and_jitter():
     tp = parse("G1 X200 F6000")
-    motion = fir.run(tp, load_machine())
+    motion = fir.run(tp, load_machine(), fir.FirSettings.load())
     rec = controller_samples(motion, rate_hz=5.0, jitter_s=0.03, seed=1)
     nominal = np.arange(len(rec.t_s)) / 5.0
     assert len(rec.t_s) == pytest.approx(motion.cycle_time_s * 5, abs=1.5)
@@ -62,7 +62,7 @@ def test_controller_samples_rate_and_jitter():
 def test_nearest_sample_ignores_a_later_pass():
     # out and back along X: the point X10 is passed twice; the pairing keeps to the first pass
     tp = parse("G1 X100 F6000\nX0")
-    motion = fir.run(tp, load_machine())
+    motion = fir.run(tp, load_machine(), fir.FirSettings.load())
     rec = controller_samples(motion, rate_hz=50.0, jitter_s=0.0)
     first_pass = np.flatnonzero(motion.pos_mm[:, 0] >= 10.0)[0] * motion.period_s
     k = nearest_sample(rec, np.array([[10.0, 0, 0]]), np.array([first_pass]), window_s=0.3)

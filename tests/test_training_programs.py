@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from nctwin import gcode
-from nctwin.features import chien2023_features
+from nctwin.methods.chien2023 import features as chien2023_features
 from nctwin.programs.training import (
     GLOBAL_LENGTH_MM,
     LOCAL_LENGTH_MM,

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import torch
 
-from nctwin import zhang2023 as zh
-from nctwin.models import BPConfig, build_bp
-from nctwin.tables import load_paper_table
-from nctwin.train import Scaler, TrainConfig, Trained
+from nctwin.chapters import zhang2023 as zh
+from nctwin.learn.models import BPConfig, build_bp
+from nctwin.learn.train import Scaler, TrainConfig, Trained
+from nctwin.report.tables import load_paper_table
 
 
 def test_split_is_seeded_disjoint_and_sized() -> None:

@@ -2,7 +2,7 @@
 
 ``nctwin estimate PROGRAM [--machine NAME]
 [--method cam|kernel|block_overlap|planner|bilstm|axis_nn] [--json]`` prints the cycle time of
-a part program (by default with the machine profile's ``default_method``); ``nctwin simulate
+a part program (by default with :func:`nctwin.estimate.default_method`); ``nctwin simulate
 PROGRAM [--machine NAME] [--plot feed.png] [--csv motion.csv] [--json]`` interpolates it on the
 FIR kernel; ``nctwin machines`` lists the shipped machine profiles. Bad input ends with exit
 code 2 and one line ``file:line: reason`` on standard error, never a traceback.
@@ -16,8 +16,10 @@ import sys
 from collections.abc import Sequence
 
 from . import __version__
-from .estimate import METHODS, estimate
+from .estimate import METHODS, default_method, estimate
+from .estimate.kernel import fir_settings
 from .gcode import GCodeError, parse_file
+from .kernel import fir
 from .machine import DEFAULT_MACHINE, available_machines, load_machine
 
 __all__ = ["main"]
@@ -34,7 +36,7 @@ def _parser() -> argparse.ArgumentParser:
         "--method",
         default=None,
         choices=sorted(METHODS),
-        help="estimator (default: the machine profile's default_method, cam for most; "
+        help="estimator (default: the best one a chapter found for the machine, cam for most; "
         "bilstm and axis_nn need a machine with recordings: linuxcnc_sim)",
     )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
@@ -108,7 +110,7 @@ def _common_rows(summary: dict, machine_note: str = "") -> list[tuple[str, str]]
 
 def _estimate(args: argparse.Namespace) -> int:
     machine, tp = _load(args)
-    result = estimate(tp, machine, args.method or machine.default_method)
+    result = estimate(tp, machine, args.method or default_method(machine))
     summary = {"program": args.program, **result.summary()}
     rows = _common_rows(summary)
     rows.insert(2, ("method", result.method))
@@ -121,11 +123,8 @@ def _estimate(args: argparse.Namespace) -> int:
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from .estimate.kernel import fir_setup
-    from .kernel import fir
-
     machine, tp = _load(args)
-    motion = fir.run(*fir_setup(tp, machine))
+    motion = fir.run(tp, machine, fir_settings(machine))
     summary = {
         "program": args.program,
         "machine": machine.name,
@@ -144,7 +143,7 @@ def _simulate(args: argparse.Namespace) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        from .plots import feed_profile
+        from .report.plots import feed_profile
 
         ax = feed_profile(motion, tp, machine, title=f"{args.program} on {machine.name}")
         ax.figure.savefig(args.plot, dpi=120)

@@ -1,16 +1,20 @@
-"""Machine profiles: the settings of a virtual machine tool, loaded from ``data/machines/*.toml``.
+"""Machine profiles: what a machine tool and its control are, loaded from ``data/machines/*.toml``.
 
 A :class:`MachineProfile` holds what a control's machine data hold: axis limits, rapid and maximum
-feed, interpolation period, default blending tolerance and the time constants of its acc/dec
-filters. Every value is checked on construction; a bad one raises :class:`ValueError` naming the
-field, the value and the allowed range.
+feed, interpolation period, default blending tolerance, the time constants of its acc/dec filters
+and its servo loops. Every value is checked on construction; a bad one raises :class:`ValueError`
+naming the field, the value and the allowed range.
+
+How a virtual kernel interpolates the machine is not part of it: a profile's file may hold a
+kernel's settings in a table of their own (``[fir]`` for :class:`nctwin.kernel.fir.FirSettings`),
+read by :func:`load_table`.
 """
 
 from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 from pathlib import Path
 
 from .paths import data_dir
@@ -20,11 +24,15 @@ __all__ = [
     "MachineProfile",
     "available_machines",
     "load_machine",
+    "load_table",
+    "profile_path",
     "whole_periods",
 ]
 
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
+#: Tables of a profile's file that hold a kernel's settings (see :func:`load_table`).
+KERNEL_TABLES = ("fir",)
 
 _XYZ = tuple[float, float, float]
 
@@ -53,17 +61,6 @@ class MachineProfile:
         Interpolation period.
     blend_tol_mm : float
         Corner-blending tolerance used where the program sets none (G64 P overrides it).
-    fir_t1_s, fir_t2_s : float
-        Time constants of the FIR interpolator: acceleration ``F / T1``, jerk ``F / (T1 T2)``.
-    fir_acc_scale : float
-        The FIR kernel enforces the axis accelerations times this (1 for the kernel's own
-        machines; fitted where the kernel stands in for another control).
-    fir_blend_ratio : float
-        The FIR kernel blends a junction within at most this share of the shorter of its two
-        moves (a plain ``G64`` within this alone); ``inf``: the program's tolerance only.
-    fir_block_periods : int
-        Shortest time of a move on the FIR kernel, in periods (a control's block-processing
-        rate): a move of length ``l`` runs at most at ``l / (n period_s)``; 0: no limit.
     cut_time_constant_s : float
         Acc/dec time constant of cutting feed (linear type, after interpolation).
     rapid_time_constant_s : float
@@ -82,9 +79,6 @@ class MachineProfile:
     inposition_time_s : tuple of 3 floats
         Measured in-position time of X, Y, Z after a rapid, used by analytic estimators
         (Lee et al. 2022, Sec. 2.3); 0 where not measured.
-    default_method : str
-        Estimator ``nctwin estimate`` uses when none is named: the best one the chapter that
-        measured this machine found (``cam`` where none did).
     """
 
     name: str
@@ -96,11 +90,6 @@ class MachineProfile:
     max_feed_mm_s: float
     period_s: float = 0.001
     blend_tol_mm: float = 0.05
-    fir_t1_s: float = 0.05
-    fir_t2_s: float = 0.01
-    fir_acc_scale: float = 1.0
-    fir_blend_ratio: float = math.inf
-    fir_block_periods: int = 0
     cut_time_constant_s: float = 0.05
     rapid_time_constant_s: float = 0.1
     rapid_bell_s: float = 0.0
@@ -108,7 +97,6 @@ class MachineProfile:
     position_gain_per_s: _XYZ = (30.0, 30.0, 30.0)
     inposition_width_mm: _XYZ = (0.02, 0.02, 0.02)
     inposition_time_s: _XYZ = (0.0, 0.0, 0.0)
-    default_method: str = "cam"
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -138,16 +126,9 @@ class MachineProfile:
         _check("max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf)
         _check("period_s", self.period_s, 0.0, 0.1, hi_closed=True)
         _check("blend_tol_mm", self.blend_tol_mm, 0.0, 10.0, lo_closed=True, hi_closed=True)
-        for f in ("fir_t1_s", "fir_t2_s", "cut_time_constant_s", "rapid_time_constant_s"):
+        for f in ("cut_time_constant_s", "rapid_time_constant_s"):
             _check(f, getattr(self, f), 0.0, 10.0, lo_closed=True, hi_closed=True)
         _check("rapid_bell_s", self.rapid_bell_s, 0.0, 10.0, lo_closed=True, hi_closed=True)
-        _check("fir_acc_scale", self.fir_acc_scale, 0.0, 100.0)
-        _check("fir_blend_ratio", self.fir_blend_ratio, 0.0, 1.0, hi_closed=True, allow_inf=True)
-        if not isinstance(self.fir_block_periods, int) or not 0 <= self.fir_block_periods <= 100:
-            raise ValueError(
-                f"fir_block_periods = {self.fir_block_periods!r} is out of range: "
-                "allowed integers in [0, 100]"
-            )
         if self.rapid_type not in ("linear", "nonlinear"):
             raise ValueError(
                 f"rapid_type = {self.rapid_type!r} is not allowed: allowed 'linear', 'nonlinear'"
@@ -156,15 +137,10 @@ class MachineProfile:
     @classmethod
     def from_toml(cls, path: str | Path) -> MachineProfile:
         """Read a profile from a TOML file (keys as the dataclass fields; ``name`` defaults to
-        the file's stem)."""
+        the file's stem; the tables of :data:`KERNEL_TABLES` are a kernel's, not the
+        profile's)."""
         p = Path(path)
-        try:
-            with p.open("rb") as fh:
-                data = tomllib.load(fh)
-        except OSError as exc:
-            raise ValueError(f"cannot read machine profile {p}: {exc.strerror or exc}") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"machine profile {p} is not valid TOML: {exc}") from None
+        data = {k: v for k, v in _read_toml(p).items() if k not in KERNEL_TABLES}
         allowed = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - allowed)
         if unknown:
@@ -172,12 +148,23 @@ class MachineProfile:
                 f"{p}: unknown field(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}"
             )
         data.setdefault("name", p.stem)
+        missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in data]
+        if missing:
+            raise ValueError(f"{p}: missing field(s) {', '.join(missing)}")
         try:
             return cls(**data)
-        except TypeError as exc:  # a required field is missing
-            raise ValueError(f"{p}: {exc}") from None
         except ValueError as exc:
             raise ValueError(f"{p}: {exc}") from None
+
+
+def _read_toml(p: Path) -> dict:
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except OSError as exc:
+        raise ValueError(f"cannot read machine profile {p}: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"machine profile {p} is not valid TOML: {exc}") from None
 
 
 def _check(
@@ -229,23 +216,45 @@ def available_machines() -> list[str]:
     return sorted(p.stem for p in machines_dir().glob("*.toml"))
 
 
-def load_machine(name: str | Path | None = None) -> MachineProfile:
-    """Load a shipped profile by name, or a profile file by path.
+def profile_path(name: str | Path | None = None) -> Path:
+    """The file of a shipped profile by name, or a profile file by path (``.toml``).
 
     Parameters
     ----------
     name : str or Path, optional
         A name from :func:`available_machines`, or a path to a ``.toml`` file. Default:
         :data:`DEFAULT_MACHINE`.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is neither.
     """
     name = DEFAULT_MACHINE if name is None else name
     p = Path(name)
     if p.suffix == ".toml" or p.exists():
-        return MachineProfile.from_toml(p)
+        return p
     shipped = machines_dir() / f"{name}.toml"
     if not shipped.exists():
         raise ValueError(
             f"machine = {str(name)!r} is unknown: allowed "
             f"{', '.join(available_machines())} or a path to a .toml file"
         )
-    return MachineProfile.from_toml(shipped)
+    return shipped
+
+
+def load_machine(name: str | Path | None = None) -> MachineProfile:
+    """Load a shipped profile by name, or a profile file by path (see :func:`profile_path`)."""
+    return MachineProfile.from_toml(profile_path(name))
+
+
+def load_table(name: str | Path | None, table: str) -> dict:
+    """A kernel's table of a profile's file (one of :data:`KERNEL_TABLES`); empty if the file
+    has none."""
+    if table not in KERNEL_TABLES:
+        raise ValueError(f"table = {table!r} is unknown: allowed {', '.join(KERNEL_TABLES)}")
+    p = profile_path(name)
+    data = _read_toml(p).get(table, {})
+    if not isinstance(data, dict):
+        raise ValueError(f"{p}: {table} must be a table ([{table}])")
+    return data

@@ -8,11 +8,9 @@ The package is used from a clone (``pip install -e .``, as ``make`` does): shipp
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 __all__ = [
-    "atomic_write_text",
     "cache_dir",
     "data_dir",
     "public_programs_dir",
@@ -42,25 +40,7 @@ def cache_dir() -> Path:
 
 
 def public_programs_dir() -> Path:
-    """Public part programs written by others (``../shared/programs`` beside the clone, or
-    ``NCTWIN_PUBLIC_PROGRAMS``). They are not shipped and may be absent."""
-    default = repo_root().parent / "shared" / "programs"
-    return Path(os.environ.get("NCTWIN_PUBLIC_PROGRAMS", default))
-
-
-def atomic_write_text(path: Path, text: str) -> Path:
-    """Write ``text`` to ``path`` via a temporary file in the same folder and ``os.replace``,
-    so that an interrupted run never leaves a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    """Public part programs written by others (LinuxCNC's and CAMotics' examples), shipped in
+    ``data/programs/public/`` byte for byte under their own licence (GPL, not the MIT code's);
+    its README gives each file's origin, licence and SHA-256."""
+    return data_dir() / "programs" / "public"

@@ -38,19 +38,84 @@ Conventions: the filters act on the command positions sampled at the interpolati
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+import math
+from dataclasses import dataclass, fields
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from .._rows import row_min, row_norm
 from ..geometry import PathGeometry
-from ..machine import MachineProfile
+from ..machine import MachineProfile, load_table
 from ..motion import Motion
-from ..toolpath import MotionKind, Toolpath
+from ..toolpath import MotionKind, PathMode, Toolpath
 from . import _fir_loops
 
-__all__ = ["FirFilter", "corner_deviation_mm", "plan", "run"]
+__all__ = ["FirFilter", "FirSettings", "corner_deviation_mm", "plan", "run", "stand_in"]
+
+
+@dataclass(frozen=True)
+class FirSettings:
+    """How the FIR kernel interpolates a machine: the kernel's settings, apart from what the
+    machine is (:class:`~nctwin.machine.MachineProfile`).
+
+    Parameters
+    ----------
+    t1_s, t2_s : float
+        Time constants of the two moving averages: acceleration ``F / T1``, jerk
+        ``F / (T1 T2)``; in [0, 10] s (the longer must be at least one period).
+    acc_scale : float
+        The kernel enforces the axis accelerations times this, in (0, 100) (1 for the kernel's
+        own machines; fitted where the kernel stands in for another control).
+    blend_ratio : float
+        The kernel blends a junction within at most this share of the shorter of its two moves
+        (a plain ``G64`` within this alone), in (0, 1]; ``inf``: the program's tolerance only.
+    block_periods : int
+        Shortest time of a move, in periods (a control's block-processing rate): a move of
+        length ``l`` runs at most at ``l / (n period_s)``; in [0, 100], 0: no limit.
+    """
+
+    t1_s: float = 0.05
+    t2_s: float = 0.01
+    acc_scale: float = 1.0
+    blend_ratio: float = math.inf
+    block_periods: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("t1_s", "t2_s"):
+            v = getattr(self, name)
+            if not (_is_number(v) and 0.0 <= v <= 10.0):
+                raise ValueError(f"{name} = {v!r} is out of range: allowed [0, 10]")
+        if not (_is_number(self.acc_scale) and 0.0 < self.acc_scale < 100.0):
+            raise ValueError(f"acc_scale = {self.acc_scale!r} is out of range: allowed (0, 100)")
+        r = self.blend_ratio
+        if not (_is_number(r) and (0.0 < r <= 1.0 or r == math.inf)):
+            raise ValueError(f"blend_ratio = {r!r} is out of range: allowed (0, 1] or inf")
+        n = self.block_periods
+        if not (isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 100):
+            raise ValueError(
+                f"block_periods = {n!r} is out of range: allowed integers in [0, 100]"
+            )
+
+    @classmethod
+    def load(cls, machine: str | Path | None = None) -> FirSettings:
+        """The ``[fir]`` table of a profile's file (:func:`nctwin.machine.load_table`); the
+        defaults where it has none."""
+        data = load_table(machine, "fir")
+        allowed = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - allowed)
+        if unknown:
+            raise ValueError(
+                f"[fir] of {machine}: unknown field(s) {', '.join(unknown)}; allowed: "
+                f"{', '.join(sorted(allowed))}"
+            )
+        return cls(**data)
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and not math.isnan(v)
 
 
 @dataclass(frozen=True)
@@ -77,14 +142,14 @@ class FirFilter:
             lo = self.period_s if name == "t1_s" else 0.0
             if not (lo <= v <= 10.0):
                 raise ValueError(
-                    f"fir_{name} = {v!r} is out of range for the FIR kernel: allowed [{lo:g}, 10]"
+                    f"{name} = {v!r} is out of range for the FIR kernel: allowed [{lo:g}, 10]"
                 )
 
     @classmethod
-    def of(cls, machine: MachineProfile) -> FirFilter:
-        """The filter of a machine profile (the longer time constant first)."""
-        t1, t2 = max(machine.fir_t1_s, machine.fir_t2_s), min(machine.fir_t1_s, machine.fir_t2_s)
-        return cls(t1, t2, machine.period_s)
+    def of(cls, settings: FirSettings, period_s: float) -> FirFilter:
+        """The filter of the kernel's settings (the longer time constant first)."""
+        t1, t2 = max(settings.t1_s, settings.t2_s), min(settings.t1_s, settings.t2_s)
+        return cls(t1, t2, period_s)
 
     @property
     def taps(self) -> tuple[int, int]:
@@ -251,13 +316,12 @@ def _deviation_nodes(fir: FirFilter) -> tuple[np.ndarray, np.ndarray]:
 def plan(
     tp: Toolpath,
     machine: MachineProfile,
-    fir: FirFilter | None = None,
+    fir: FirFilter,
     geo: PathGeometry | None = None,
 ) -> Plan:
     """Look-ahead: cruise feeds, junction speeds and pauses (see the module docstring).
 
-    ``fir`` and ``geo`` default to the machine's filter and the path's geometry."""
-    fir = fir or FirFilter.of(machine)
+    ``geo`` defaults to the path's geometry."""
     n = len(tp)
     geo = geo if geo is not None else PathGeometry(tp)
     feed = _block_feeds(tp, machine, fir)
@@ -524,22 +588,63 @@ def _moves(tp: Toolpath) -> np.ndarray:
     return moves
 
 
-def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
+def stand_in(
+    toolpath: Toolpath, machine: MachineProfile, settings: FirSettings
+) -> tuple[Toolpath, MachineProfile]:
+    """The tool path and profile the kernel plans, with the settings that make it stand in for
+    another control: ``acc_scale`` scales the axis accelerations; ``blend_ratio`` lowers the
+    tolerance of each junction to that share of the shorter of its two moves (written as the
+    ``G64 P`` of the block that starts there); ``block_periods`` caps the feed of each cutting
+    move at its length over that many periods. With the defaults (1, inf, 0) both come back
+    unchanged.
+    """
+    if settings.acc_scale != 1.0:
+        acc = tuple(settings.acc_scale * a for a in machine.axis_max_acceleration_mm_s2)
+        machine = dataclasses.replace(machine, axis_max_acceleration_mm_s2=acc)
+    if settings.blend_ratio == np.inf and settings.block_periods == 0:
+        return toolpath, machine
+    length = toolpath.lengths_mm
+    moving = length > 0
+    tol = toolpath.effective_tolerance_mm(machine.blend_tol_mm)
+    prev = np.full(len(toolpath), np.inf)
+    idx = np.flatnonzero(moving)
+    prev[idx[1:]] = length[idx[:-1]]
+    limit = np.where(moving, settings.blend_ratio * np.minimum(length, prev), np.inf)
+    new_tol = np.where(tol > 0, np.minimum(tol, limit), tol)
+    blend = np.isfinite(new_tol) & (new_tol > 0) & (new_tol != tol)
+    feed = toolpath.feed_mm_s
+    if settings.block_periods:
+        cap = length / (settings.block_periods * machine.period_s)
+        feed = np.where((toolpath.kind != MotionKind.RAPID) & moving, np.minimum(feed, cap), feed)
+    toolpath = dataclasses.replace(
+        toolpath,
+        feed_mm_s=feed,
+        path_mode=np.where(blend, PathMode.BLEND, toolpath.path_mode).astype(np.int8),
+        blend_tol_mm=np.where(blend, new_tol, toolpath.blend_tol_mm),
+    )
+    return toolpath, machine
+
+
+def run(toolpath: Toolpath, machine: MachineProfile, settings: FirSettings) -> Motion:
     """Interpolate a tool path on the FIR kernel.
 
     Parameters
     ----------
     toolpath : Toolpath
     machine : MachineProfile
-        Supplies ``fir_t1_s``, ``fir_t2_s``, ``period_s``, ``blend_tol_mm``, the axis limits,
-        the rapid feed and the maximum feed.
+        Supplies ``period_s``, ``blend_tol_mm``, the axis limits, the rapid feed and the
+        maximum feed.
+    settings : FirSettings
+        The kernel's filters and stand-in settings (:func:`stand_in`).
 
     Returns
     -------
     Motion
-        Samples every ``period_s`` from rest at the start to rest at the end.
+        Samples every ``period_s`` from rest at the start to rest at the end, labelled with
+        the blocks of ``toolpath``.
     """
-    fir = FirFilter.of(machine)
+    toolpath, machine = stand_in(toolpath, machine, settings)
+    fir = FirFilter.of(settings, machine.period_s)
     ts = fir.period_s
     # zero-length moves are no-ops: plan without them, report the kept blocks' indices
     kept = np.flatnonzero(_moves(toolpath) | (toolpath.kind == MotionKind.DWELL))

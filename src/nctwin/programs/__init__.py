@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..paths import atomic_write_text
+from ..cache import atomic_write_text
 
 __all__ = ["write_programs"]
 

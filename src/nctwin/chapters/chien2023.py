@@ -1,7 +1,7 @@
 r"""The experiment of Chien, Sencer & Ward (2023): run programs on the FIR kernel, learn the
 average feed per G-line, predict cycle times.
 
-Per program (Sec. 2.2, eq. 1-3): the features of :func:`nctwin.features.chien2023_features`,
+Per program (Sec. 2.2, eq. 1-3): the features of bla,
 and two targets per G-line read from the kernel's motion at the junction points,
 
 * the average feed :math:`\bar f_k = \tilde l_k / \tilde t_k` (eq. 2), and
@@ -24,7 +24,8 @@ The average feed :math:`\hat{\bar f}_k` is what Figs. 7 and 9 show.
 Where a G-line's two junction points are the same sample (:math:`\tilde t_k = 0`, a fraction of a
 percent of the short G-lines), :math:`\bar f_k` is undefined and left out of the loss.
 
-"Machine B" (Table 3) is recorded the way a real control's trace is: :class:`Recording` adds a
+"Machine B" (Table 3) is recorded the way a real control's trace is:
+:class:`~nctwin.physics.measure.Recording` adds a
 first-order position loop (servo lag, with the wait for the in-position window at the end) and
 encoder noise to the kernel's command positions before the targets are read. The block label of
 each recorded sample is delayed by the loop's following time :math:`1/K_v` with the position, so
@@ -40,37 +41,39 @@ recording, written atomically.
 
 from __future__ import annotations
 
-import hashlib
 import itertools
-import json
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
-from scipy.signal import lfilter
-from tqdm import tqdm
 
-from . import gcode, paths
-from .estimate import cam
-from .features import block_targets, chien2023_features
-from .kernel import fir
-from .machine import MachineProfile
-from .motion import Motion
-from .programs import write_programs
-from .tables import error_pct, side_by_side
-from .toolpath import MotionKind, Toolpath
-from .train import Trained
+from .. import gcode
+from ..cache import atomic_savez, cache_path, content_key
+from ..estimate import cam
+from ..estimate.kernel import fir_settings
+from ..kernel import fir
+from ..learn.models import ModelConfig
+from ..learn.train import TrainConfig, Trained
+from ..machine import MachineProfile
+from ..methods import chien2023 as chien
+from ..motion import Motion
+from ..physics.measure import Recording
+from ..programs import write_programs
+from ..report.tables import Claim, error_pct, side_by_side
+from ..runner import run_tasks
+from ..targets import block_targets
+from ..toolpath import MotionKind, Toolpath
 
 __all__ = [
+    "LSTM_CONFIG",
     "MIN_FEED_MM_S",
+    "MLP_CONFIG",
     "TABLE_COLUMNS",
     "ProgramRun",
     "Recording",
     "ablation_table",
+    "claims",
     "cutting_blocks",
     "cycle_time_rows",
     "feed_rmse_mm_s",
@@ -81,6 +84,7 @@ __all__ = [
     "simulate",
     "simulate_one",
     "time_by_length",
+    "train_config",
     "write_programs",
 ]
 
@@ -88,56 +92,31 @@ __all__ = [
 CACHE_VERSION = 3
 #: Floor of a predicted average feed (mm/s), so that a prediction near 0 stays a finite time.
 MIN_FEED_MM_S = 1.0
+#: The ablation's models without look-ahead (the paper's BiLSTM is
+#: :data:`nctwin.methods.chien2023.BILSTM_CONFIG`): a forward-only LSTM of 10 units and a per-line
+#: MLP of two tanh layers of 32 units.
+LSTM_CONFIG = ModelConfig("lstm", n_inputs=5, n_outputs=2, hidden=10)
+MLP_CONFIG = ModelConfig("mlp", n_inputs=5, n_outputs=2, hidden=32, mlp_layers=2)
 
 
-@dataclass(frozen=True)
-class Recording:
-    """What a real control's recorded trace adds to the kernel's command positions.
+def train_config(seed: int = 0, scale: float = 1.0) -> TrainConfig:
+    """The chapter's training settings: at most ``150 * scale`` epochs (at least 5), early
+    stopping after 15 epochs without improvement, the length feature (column 1) as its
+    logarithm.
 
     Parameters
     ----------
-    position_gain_1_s : float
-        Gain ``Kv`` of a first-order position loop per axis (1/s); the actual position lags the
-        command by ``F / Kv``, in time by ``1 / Kv``, and so do the recorded block labels. 0: no
-        lag (the simulation profile).
-    in_position_mm : float
-        The motion ends when every axis is this close to the end point.
-    noise_mm : float
-        Standard deviation of the encoder noise on every recorded position.
     seed : int
-        Seed of the noise (combined with the program's index).
+        Seed of the initial weights, the validation split and the batch order.
+    scale : float
+        Multiplies the training budget (1.0: the paper's).
+
+    Returns
+    -------
+    TrainConfig
     """
-
-    position_gain_1_s: float = 0.0
-    in_position_mm: float = 0.001
-    noise_mm: float = 0.0
-    seed: int = 0
-
-    def apply(self, motion: Motion, rng: np.random.Generator) -> Motion:
-        """The recorded motion: lagged, extended until in position, noisy; the block labels
-        delayed by the following time."""
-        ts = motion.period_s
-        pos = motion.pos_mm
-        block = motion.block
-        if self.position_gain_1_s > 0:
-            a = 1.0 - np.exp(-self.position_gain_1_s * ts)
-            # settle: the lag decays by (1 - a) per sample from at most the largest lag
-            lag_mm = np.abs(pos - np.roll(pos, 1, axis=0))[1:].max(initial=0.0) / a
-            extra = int(np.ceil(np.log(self.in_position_mm / max(lag_mm, 1e-12)) / np.log(1 - a)))
-            extra = max(extra, 0)
-            cmd = np.vstack([pos, np.repeat(pos[-1:], extra, axis=0)])
-            # y[n] = (1 - a) y[n-1] + a x[n-1], at rest on the first command position
-            pos = np.column_stack(
-                [lfilter([0.0, a], [1.0, a - 1.0], cmd[:, i], zi=cmd[:1, i])[0] for i in range(3)]
-            )
-            delay = round(1.0 / a)  # the loop's following time in samples (1 / Kv as ts -> 0)
-            block = np.concatenate([np.full(delay, block[0]), block, np.full(extra, block[-1])])
-            block = block[: len(pos)]
-        if self.noise_mm > 0:
-            pos = pos + rng.normal(0.0, self.noise_mm, pos.shape)
-        vel = np.zeros_like(pos)
-        vel[1:] = np.diff(pos, axis=0) / ts
-        return Motion(np.arange(len(pos)) * ts, pos, vel, block, ts)
+    epochs = max(5, round(150 * scale))
+    return TrainConfig(seed=seed, max_epochs=epochs, patience=15, log_inputs=(1,))
 
 
 @dataclass(frozen=True)
@@ -147,7 +126,7 @@ class ProgramRun:
     Parameters
     ----------
     features : ndarray, shape (N, 5)
-        :func:`nctwin.features.chien2023_features`.
+        bla.
     targets : ndarray, shape (N, 2)
         Average feed :math:`\\bar f_k` (mm/s, NaN where undefined) and time ratio :math:`s_k`.
     block_time_s : ndarray, shape (N,)
@@ -179,14 +158,14 @@ def simulate_one(
     ``index`` seeds the recording's noise together with ``recording.seed``.
     """
     tp = cutting_blocks(gcode.parse(text))
-    motion = fir.run(tp, machine)
+    motion = fir.run(tp, machine, fir_settings(machine))
     if recording is not None:
         motion = recording.apply(motion, np.random.default_rng([recording.seed, index]))
     bt = block_targets(motion, tp)
     lengths = tp.lengths_mm
     targets = np.column_stack([bt.avg_feed_mm_s, tp.feed_mm_s * bt.time_s / lengths])
     return ProgramRun(
-        chien2023_features(tp, machine.blend_tol_mm),
+        chien.features(tp, machine.blend_tol_mm),
         targets,
         bt.time_s,
         bt.cycle_time_s,
@@ -224,7 +203,7 @@ def recording_effects(
         of G-lines whose two junction points are the same sample (``zero_time_pct``).
     """
     tp = cutting_blocks(gcode.parse(text))
-    motion = fir.run(tp, machine)
+    motion = fir.run(tp, machine, fir_settings(machine))
     lengths = tp.lengths_mm
     short = lengths < short_mm
 
@@ -263,37 +242,25 @@ def recording_effects(
 
 
 def _cache_key(texts: Sequence[str], machine: MachineProfile, recording: Recording | None) -> str:
-    h = hashlib.sha256()
-    for t in texts:
-        h.update(hashlib.sha256(t.encode()).digest())
     meta = {
         "version": CACHE_VERSION,
-        "machine": {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(machine).items()},
+        "machine": asdict(machine),
+        "fir": asdict(fir_settings(machine)),
         "recording": None if recording is None else asdict(recording),
     }
-    h.update(json.dumps(meta, sort_keys=True, default=str).encode())
-    return h.hexdigest()
+    return content_key(*texts, meta)
 
 
 def _save_runs(path, runs: Sequence[ProgramRun]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp.npz")
-    os.close(fd)
-    try:
-        np.savez(
-            tmp,
-            offsets=np.cumsum([0] + [len(r.features) for r in runs]),
-            features=np.concatenate([r.features for r in runs]),
-            targets=np.concatenate([r.targets for r in runs]),
-            block_time_s=np.concatenate([r.block_time_s for r in runs]),
-            measured_s=np.array([r.measured_s for r in runs]),
-            cam_s=np.array([r.cam_s for r in runs]),
-        )
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_savez(
+        path,
+        offsets=np.cumsum([0] + [len(r.features) for r in runs]),
+        features=np.concatenate([r.features for r in runs]),
+        targets=np.concatenate([r.targets for r in runs]),
+        block_time_s=np.concatenate([r.block_time_s for r in runs]),
+        measured_s=np.array([r.measured_s for r in runs]),
+        cam_s=np.array([r.cam_s for r in runs]),
+    )
 
 
 def _load_runs(path) -> list[ProgramRun]:
@@ -320,7 +287,8 @@ def simulate(
     desc: str = "programs",
     cache: bool = True,
 ) -> list[ProgramRun]:
-    """Run every program of ``texts`` (see :func:`simulate_one`), through joblib, cached.
+    """Run every program of ``texts`` (see :func:`simulate_one`) through
+    :func:`nctwin.runner.run_tasks`, cached.
 
     Parameters
     ----------
@@ -342,12 +310,11 @@ def simulate(
     list of ProgramRun
         In the order of ``texts``.
     """
-    path = paths.cache_dir() / "chien2023" / f"{_cache_key(texts, machine, recording)}.npz"
+    path = cache_path("chien2023", "runs", _cache_key(texts, machine, recording), ".npz")
     if cache and path.exists():
         return _load_runs(path)
-    jobs = (delayed(simulate_one)(t, machine, recording, i) for i, t in enumerate(texts))
-    parallel = Parallel(n_jobs=n_jobs, return_as="generator")
-    runs = list(tqdm(parallel(jobs), total=len(texts), desc=desc, leave=False, mininterval=5.0))
+    tasks = ((t, machine, recording, i) for i, t in enumerate(texts))
+    runs = run_tasks(simulate_one, tasks, n_jobs=n_jobs, desc=desc)
     if cache:
         _save_runs(path, runs)
     return runs
@@ -365,9 +332,7 @@ def predict_run(trained: Trained, run: ProgramRun) -> tuple[np.ndarray, np.ndarr
     cycle_time_s : float
         Their sum (eq. 3).
     """
-    y = trained.predict(run.features)
-    feed = np.maximum(y[:, 0], MIN_FEED_MM_S)
-    t = np.maximum(y[:, 1], 0.0) * run.features[:, 1] / run.features[:, 0]
+    feed, t = chien.predict(trained.predict(run.features), run.features)
     return feed, t, float(t.sum())
 
 
@@ -425,7 +390,7 @@ def time_by_length(
             measured, predicted = run.block_time_s[sel].sum(), t_hat[sel].sum()
             row |= {f"{label}_lines": int(sel.sum()), f"{label}_measured_s": measured,
                     f"{label}_predicted_s": predicted,
-                    f"{label}_err_pct": 100.0 * (predicted - measured) / measured}  # fmt: skip
+                    f"{label}_err_pct": error_pct(predicted, measured, signed=True)}  # fmt: skip
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -512,3 +477,43 @@ def ablation_table(rows: pd.DataFrame, models: dict[str, Trained], runs) -> pd.D
             }
         )
     return pd.DataFrame(out).round(2)
+
+
+def claims(
+    rows: pd.DataFrame, rows_b: pd.DataFrame, table1: pd.DataFrame, table2: pd.DataFrame
+) -> list[Claim]:
+    """The chapter's claims, with the tolerances of the issue.
+
+    The BiLSTM's error is at most 3 % on every simulation row (the paper prints 0.8-2.2 %), at
+    most 7 % on every machine-B row (paper: 3-6 %); CAM underestimates every row, by at least
+    20 % on Tables 1 and 2 (paper: 27-41 %).
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        :func:`cycle_time_rows` of the simulation's test programs (Tables 1-2), with a
+        ``bilstm`` model.
+    rows_b : pandas.DataFrame
+        The same for machine B (Table 3).
+    table1, table2 : pandas.DataFrame
+        :func:`paper_beside` of Tables 1 and 2 (column ``cam_err_pct``).
+
+    Returns
+    -------
+    list of Claim
+    """
+    sim_rows = rows
+    return [
+        Claim("sim_bilstm_err_max",
+              "BiLSTM error <= 3 % on every row of Tables 1-2 (paper 0.8-2.2 %)",
+              sim_rows.bilstm_err_pct.max(), "<=", 3.0),
+        Claim("b_bilstm_err_max", "BiLSTM error <= 7 % on every row of Table 3 (paper 3-6 %)",
+              rows_b.bilstm_err_pct.max(), "<=", 7.0),
+        Claim("cam_underestimates", "CAM underestimates on every row of Tables 1-3 (count of rows "
+              "where it does not)", ((sim_rows.cam_s >= sim_rows.measured_s).sum()
+                                     + (rows_b.cam_s >= rows_b.measured_s).sum()), "==", 0),
+        Claim("table1_cam_err_min", "CAM error >= 20 % on every row of Table 1 (paper 27-34 %)",
+              table1.cam_err_pct.min(), ">=", 20.0),
+        Claim("table2_cam_err_min", "CAM error >= 20 % on every row of Table 2 (paper 35-41 %)",
+              table2.cam_err_pct.min(), ">=", 20.0),
+    ]  # fmt: skip

@@ -9,34 +9,37 @@ The chapter's pipeline, kept out of the notebook:
    also keeps the true axis feeds at each cutter location (1 kHz), which the paper did not have.
 2. :func:`train_axis_models` fits one network per axis (Table 1 features, 2 hidden tanh layers of
    5 and 10, linear output, MSE) on the training pockets of Table 2, validating on the first half
-   of pocket 4, with :func:`nctwin.train.fit`.
+   of pocket 4, with :func:`nctwin.learn.train.fit`.
 3. :func:`predict_time` turns the predicted axis feeds into the resultant feed (eq. 9) and the
    machining time (eq. 10).
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
 
-from .estimate import estimate
-from .features import block_targets, sun2022_features
-from .gcode import parse
-from .kernel import fir
-from .machine import MachineProfile
-from .measure import ControllerSamples, controller_samples, nearest_sample
-from .models import ModelConfig
-from .motion import Motion
-from .programs.thinwall import HOME_MM, POCKETS, pocket_program
-from .toolpath import MotionKind, Toolpath
-from .train import TrainConfig, Trained, fit
+from ..estimate import estimate
+from ..estimate.kernel import fir_settings
+from ..gcode import parse
+from ..kernel import fir
+from ..learn.train import TrainConfig, Trained, fit
+from ..machine import MachineProfile
+from ..methods import sun2022 as sun
+from ..motion import Motion
+from ..physics.measure import ControllerSamples, controller_samples, nearest_sample
+from ..programs.thinwall import HOME_MM, POCKETS, pocket_program
+from ..report.tables import Claim, error_pct
+from ..runner import run_tasks
+from ..targets import block_targets
+from ..toolpath import MotionKind, Toolpath
 
 __all__ = [
-    "MODEL_CONFIG",
     "PocketRun",
+    "claims",
     "oracle_time",
     "predict_feeds",
     "predict_time",
@@ -45,14 +48,6 @@ __all__ = [
     "time_table",
     "train_axis_models",
 ]
-
-#: The paper's network: 9 features, hidden layers of 5 and 10 tanh neurons, one linear output.
-MODEL_CONFIG = ModelConfig(kind="mlp", n_inputs=9, n_outputs=1, mlp_widths=(5, 10))
-
-#: Lowest resultant feed eq. 10 divides by, as a share of the commanded feed: a network that
-#: predicts a standstill on a cutting move would otherwise give an infinite time.
-MIN_FEED_SHARE = 0.01
-
 
 @dataclass(frozen=True, eq=False)
 class PocketRun:
@@ -68,7 +63,7 @@ class PocketRun:
     records : ControllerSamples
         What the 5 Hz logger recorded.
     features : ndarray, shape (N, 3, 9)
-        :func:`nctwin.features.sun2022_features`.
+        :func:`nctwin.methods.sun2022.features`.
     measured_feed_mm_s : ndarray, shape (N, 3)
         Axis feeds of the record nearest to each cutter location (the paper's targets).
     true_feed_mm_s : ndarray, shape (N, 3)
@@ -102,15 +97,15 @@ def run_pocket(
     text: str,
     number: int,
     machine: MachineProfile,
+    seed: int = 0,
     *,
     rate_hz: float = 5.0,
     jitter_s: float = 0.03,
-    seed: int = 0,
 ) -> PocketRun:
     """Run one pocket program on the FIR kernel and record it; see the module docstring."""
     parsed = parse(text, start_mm=HOME_MM, source=f"pocket {number}")
     tp = parsed.take(parsed.lengths_mm > 0)
-    motion = fir.run(tp, machine)
+    motion = fir.run(tp, machine, fir_settings(machine))
     junction = block_targets(motion, tp).junction_sample
     passage = junction[1:]
     dt = np.diff(junction)[:, None] * motion.period_s
@@ -124,7 +119,7 @@ def run_pocket(
         toolpath=tp,
         motion=motion,
         records=records,
-        features=sun2022_features(tp, machine.rapid_feed_mm_s),
+        features=sun.features(tp, machine.rapid_feed_mm_s),
         measured_feed_mm_s=records.vel_mm_s[nearest],
         true_feed_mm_s=block_avg,
         commanded_mm_s=commanded,
@@ -137,13 +132,8 @@ def run_pockets(
 ) -> dict[int, PocketRun]:
     """All eight pockets, in parallel through joblib (``n_jobs``); each pocket's record jitter
     is seeded with ``seed + number``. ``kwargs`` go to :func:`run_pocket`."""
-    jobs = (
-        delayed(run_pocket)(
-            pocket_program(spec), spec.number, machine, seed=seed + spec.number, **kwargs
-        )
-        for spec in POCKETS
-    )
-    runs = Parallel(n_jobs=n_jobs)(jobs)
+    tasks = ((pocket_program(spec), spec.number, machine, seed + spec.number) for spec in POCKETS)
+    runs = run_tasks(functools.partial(run_pocket, **kwargs), tasks, n_jobs=n_jobs)
     return {r.number: r for r in runs}
 
 
@@ -194,7 +184,7 @@ def train_axis_models(
 
         models.append(
             fit(
-                MODEL_CONFIG,
+                sun.MODEL_CONFIG,
                 cfg,
                 [runs[p].features[:, axis] for p in train_pockets],
                 [ys(runs[p]) for p in train_pockets],
@@ -217,9 +207,9 @@ def predict_time(models: list[Trained], run: PocketRun) -> tuple[float, np.ndarr
     Returns the time (s) and the resultant feed at each cutter location, shape (N,). The
     resultant feed is kept above :data:`MIN_FEED_SHARE` of the commanded feed.
     """
-    resultant = np.linalg.norm(predict_feeds(models, run), axis=1)  # eq. 9
-    resultant = np.maximum(resultant, MIN_FEED_SHARE * run.commanded_mm_s)
-    return float((run.toolpath.lengths_mm / resultant).sum()), resultant  # eq. 10
+    feeds = predict_feeds(models, run)
+    t = sun.block_times_s(feeds, run.toolpath.lengths_mm, run.commanded_mm_s)
+    return float(t.sum()), sun.resultant_feed_mm_s(feeds, run.commanded_mm_s)
 
 
 def time_table(runs: dict[int, PocketRun], models: list[Trained]) -> pd.DataFrame:
@@ -235,9 +225,9 @@ def time_table(runs: dict[int, PocketRun], models: list[Trained]) -> pd.DataFram
                 "pocket": k,
                 "measured_s": run.measured_s,
                 "cam_s": run.cam_s,
-                "cam_err_pct": 100.0 * (run.cam_s - run.measured_s) / run.measured_s,
+                "cam_err_pct": error_pct(run.cam_s, run.measured_s, signed=True),
                 "nn_s": nn_s,
-                "nn_err_pct": 100.0 * (nn_s - run.measured_s) / run.measured_s,
+                "nn_err_pct": error_pct(nn_s, run.measured_s, signed=True),
             }
         )
     return pd.DataFrame(rows)
@@ -246,5 +236,49 @@ def time_table(runs: dict[int, PocketRun], models: list[Trained]) -> pd.DataFram
 def oracle_time(run: PocketRun, target: str = "measured") -> float:
     """Eq. 10 fed with the targets themselves: what a perfect network would give."""
     feed = run.measured_feed_mm_s if target == "measured" else run.true_feed_mm_s
-    resultant = np.maximum(np.linalg.norm(feed, axis=1), MIN_FEED_SHARE * run.commanded_mm_s)
-    return float((run.toolpath.lengths_mm / resultant).sum())
+    return float(sun.block_times_s(feed, run.toolpath.lengths_mm, run.commanded_mm_s).sum())
+
+
+def claims(runs: dict[int, PocketRun], sources: pd.DataFrame, table3: pd.DataFrame) -> list[Claim]:
+    """The paper's claims, on its own set-up (5 Hz targets) and, as a separate row each, with
+    1 kHz block-average targets; the tolerances are the paper's own numbers.
+
+    Model #1's error is under 10 % on every pocket; model #2's is at most 3 % on every pocket and
+    lower than model #1's on the pockets model #1 did not see (all but pocket 1); CAD/CAM
+    underestimates every pocket.
+
+    Parameters
+    ----------
+    runs : dict
+        ``pocket -> PocketRun`` (only the keys are read: the pockets).
+    sources : pandas.DataFrame
+        One row per pocket with ``pocket`` and the signed errors ``m1_5hz_err_pct``,
+        ``m2_5hz_err_pct``, ``m1_1khz_err_pct``, ``m2_1khz_err_pct`` (the chapter's
+        ``error_sources`` table).
+    table3 : pandas.DataFrame
+        Table 3 (columns ``cam_s``, ``measured_s``).
+
+    Returns
+    -------
+    list of Claim
+    """
+    unseen = [k for k in runs if k != 1]
+    claims = []
+    for target, label in (("measured", "5 Hz records"), ("true", "1 kHz block averages")):
+        err = sources.set_index("pocket")
+        key = "5hz" if target == "measured" else "1khz"
+        m1, m2 = err[f"m1_{key}_err_pct"].abs(), err[f"m2_{key}_err_pct"].abs()
+        claims += [
+            Claim(f"model1_below_10pct_{key}", f"model #1 error < 10 % on every pocket ({label})",
+                  m1.max(), "<", 10.0),
+            Claim(f"model2_below_3pct_{key}", f"model #2 error <= 3 % on every pocket ({label})",
+                  m2.max(), "<=", 3.0),
+            Claim(f"model2_beats_model1_unseen_{key}",
+                  f"model #2 error lower than model #1 on every pocket model #1 did not see "
+                  f"({label}); value: largest (model #2 - model #1) in percentage points",
+                  (m2[unseen] - m1[unseen]).max(), "<", 0.0),
+        ]  # fmt: skip
+    cam_under = (table3["cam_s"] < table3["measured_s"]).all()
+    claims.append(Claim("cam_underestimates", "CAD/CAM underestimates every pocket (1 = all)",
+                        float(cam_under), "==", 1.0))
+    return claims

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 
-from .checks import check_range
+from ..checks import check_range
 
 __all__ = [
     "AxisDrive",

@@ -164,7 +164,7 @@ class BPConfig:
     Fully connected: ``n_inputs`` -> ReLU layers of ``hidden`` widths (paper: 28 and 20, sized
     by eq. 8), each followed by dropout -> linear output. One sample per row: the network maps
     (..., n_inputs) to (..., n_outputs), so it also runs on the (batch, lines, n_inputs) windows
-    of :mod:`nctwin.train`.
+    of :mod:`nctwin.learn.train`.
 
     Parameters
     ----------

@@ -47,7 +47,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from . import paths
+from .. import paths
+from ..cache import atomic_write_text
 
 __all__ = [
     "CITING_COLUMNS",
@@ -226,8 +227,9 @@ def _check_citing(df: pd.DataFrame, path: Path) -> None:
 # Errors
 
 
-def error_pct(predicted: Any, measured: Any) -> Any:
-    r"""Relative error in percent, :math:`|\hat T - T| / T \times 100`.
+def error_pct(predicted: Any, measured: Any, *, signed: bool = False) -> Any:
+    r"""Relative error in percent, :math:`|\hat T - T| / T \times 100`, or with ``signed``
+    :math:`100 (\hat T - T) / T` (negative: an underestimate). The package's one percent error.
 
     Parameters
     ----------
@@ -235,6 +237,8 @@ def error_pct(predicted: Any, measured: Any) -> Any:
         Predicted value(s) :math:`\hat T`; scalar or array-like.
     measured
         Measured value(s) :math:`T`, all > 0; broadcast against ``predicted``.
+    signed
+        Keep the sign.
 
     Returns
     -------
@@ -255,7 +259,7 @@ def error_pct(predicted: Any, measured: Any) -> Any:
     m = np.asarray(measured, dtype=float)
     if np.any(m <= 0):
         raise ValueError(f"measured must be > 0, got {m[m <= 0].ravel()[:5].tolist()}")
-    out = np.abs(p - m) / m * 100.0
+    out = 100.0 * (p - m) / m if signed else np.abs(p - m) / m * 100.0
     return float(out) if out.ndim == 0 else out
 
 
@@ -474,7 +478,7 @@ def write_table(stem: str, name: str, df: pd.DataFrame, *, results_dir: Path | N
     """
     folder = _results_folder(stem, results_dir)
     text = df.to_csv(index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
-    return paths.atomic_write_text(folder / f"{_check_simple_name(name, 'name')}.csv", text)
+    return atomic_write_text(folder / f"{_check_simple_name(name, 'name')}.csv", text)
 
 
 def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None = None) -> Path:
@@ -505,7 +509,7 @@ def write_claims(stem: str, claims: Iterable[Claim], *, results_dir: Path | None
     if len(set(ids)) != len(ids):
         raise ValueError(f"claim ids must be unique, got {ids}")
     text = json.dumps(records, sort_keys=True, indent=2, ensure_ascii=False) + "\n"
-    return paths.atomic_write_text(_results_folder(stem, results_dir) / "claims.json", text)
+    return atomic_write_text(_results_folder(stem, results_dir) / "claims.json", text)
 
 
 def _results_folder(stem: str, folder: Path | None) -> Path:

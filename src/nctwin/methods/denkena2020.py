@@ -1,5 +1,7 @@
-r"""The model-based force reconstruction of Denkena et al. (2020, Sec. 2.2, eq. 1-10).
+r"""Denkena, Bergmann & Stoppel (2020): process forces from feed-drive signals, by a model
+(Sec. 2.2, eq. 1-10) and by an LSTM (Sec. 2.3, eq. 17).
 
+**The model.**
 The process force on each axis is what is left of the motor force once the model's cogging,
 restoring, friction and inertia forces are taken off (eq. 2),
 
@@ -19,6 +21,11 @@ fitted from air moves (no cutting) in the paper's four steps, one axis at a time
    :math:`\tilde F_m = K_m I - F_{co} - k (s - s_r) - F_{fr}` (eq. 7).
 
 The motor constants :math:`K_m` are taken as known (data sheet). Units: mm, s, N, A, kg.
+
+**The LSTM.** One network per force component (:data:`MODEL_CONFIG`: 3 stacked LSTM layers of 20
+cells, dropout, a dense output) on the drive signals :data:`INPUT_NAMES`, scaled as the paper
+scales them (:class:`InputScaling`, eq. 17), learning the low-passed measured force
+(:func:`target_forces`); :func:`predict` and :func:`mc_dropout` (its uncertainty band).
 """
 
 from __future__ import annotations
@@ -26,16 +33,29 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import torch
+from scipy import signal
 from scipy.optimize import least_squares
 
+from ..learn.models import ModelConfig
+from ..learn.train import Trained
+
 __all__ = [
+    "INPUT_NAMES",
+    "MODEL_CONFIG",
+    "POSITIVE_INPUTS",
     "AxisModel",
     "ForceModel",
+    "InputScaling",
     "StribeckParams",
     "fit_masses",
     "fit_restoring",
     "fit_stribeck",
+    "lstm_inputs",
+    "mc_dropout",
+    "predict",
     "stribeck_n",
+    "target_forces",
 ]
 
 
@@ -268,3 +288,119 @@ class ForceModel:
                 - self.moved_mass_kg[i] * acc_mm_s2[:, i] * 1e-3
             )
         return out
+
+
+#: The network inputs (Sec. 2.3): X, Y, Z position, velocity, acceleration, current; spindle.
+INPUT_NAMES = (
+    "x_mm",
+    "y_mm",
+    "z_mm",
+    "vx_mm_s",
+    "vy_mm_s",
+    "vz_mm_s",
+    "ax_mm_s2",
+    "ay_mm_s2",
+    "az_mm_s2",
+    "ix_a",
+    "iy_a",
+    "iz_a",
+    "spindle_rpm",
+    "spindle_a",
+)
+
+
+#: Inputs scaled to [0, 1] (strictly positive); the others to [-1, 1].
+POSITIVE_INPUTS = (0, 1, 2, 12, 13)
+
+
+#: The paper's network: 3 stacked LSTM layers of 20 cells, dropout, one dense output.
+MODEL_CONFIG = ModelConfig(
+    kind="lstm", n_inputs=len(INPUT_NAMES), n_outputs=1, hidden=20, lstm_layers=3, dropout=0.2
+)
+
+
+def target_forces(force_n: np.ndarray, record_rate_hz: float, cutoff_hz: float = 120.0):
+    """Zero-phase Butterworth low-pass of the measured forces (Sec. 2.3), shape kept."""
+    b, a = signal.butter(2, cutoff_hz, fs=record_rate_hz)
+    return signal.filtfilt(b, a, force_n, axis=-2)
+
+
+@dataclass(frozen=True)
+class InputScaling:
+    """The paper's scalings, fitted on the training processes: inputs to [-1, 1] (x / max|x|)
+    or, for :data:`POSITIVE_INPUTS`, to [0, 1] (min-max); forces by eq. 17,
+    :math:`F^* = F / (2 |F_{max}|) + 0.5`.
+
+    Parameters
+    ----------
+    offset, scale : ndarray, shape (14,)
+    force_max_n : ndarray, shape (3,)
+    """
+
+    offset: np.ndarray
+    scale: np.ndarray
+    force_max_n: np.ndarray
+
+    @classmethod
+    def fit(cls, inputs: np.ndarray, forces: np.ndarray) -> InputScaling:
+        """From training inputs (P, R, 14) and filtered forces (P, R, 3)."""
+        x = inputs.reshape(-1, inputs.shape[-1])
+        offset = np.zeros(x.shape[1])
+        scale = np.abs(x).max(axis=0)
+        pos = list(POSITIVE_INPUTS)
+        offset[pos] = x[:, pos].min(axis=0)
+        scale[pos] = x[:, pos].max(axis=0) - offset[pos]
+        scale = np.where(scale > 0, scale, 1.0)
+        return cls(offset, scale, np.abs(forces.reshape(-1, 3)).max(axis=0))
+
+    def inputs(self, x: np.ndarray) -> np.ndarray:
+        return (x - self.offset) / self.scale
+
+    def force(self, f: np.ndarray, axis: int) -> np.ndarray:
+        """Eq. 17."""
+        return f / (2.0 * self.force_max_n[axis]) + 0.5
+
+    def force_inverse(self, f_star: np.ndarray, axis: int) -> np.ndarray:
+        return (f_star - 0.5) * 2.0 * self.force_max_n[axis]
+
+
+def lstm_inputs(scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:
+    """Scaled network inputs (R, 14) of one process."""
+    return scaling.inputs(inputs)
+
+
+def predict(nets: dict[str, Trained], scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:
+    """LSTM forces (R, 3) of one process."""
+    x = scaling.inputs(inputs)
+    return np.stack(
+        [scaling.force_inverse(nets[a].predict(x)[:, 0], i) for i, a in enumerate("XYZ")], axis=1
+    )
+
+
+def mc_dropout(
+    nets: dict[str, Trained],
+    scaling: InputScaling,
+    inputs: np.ndarray,
+    *,
+    samples: int,
+    seed: int,
+    axes: str = "XY",
+) -> np.ndarray:
+    """Monte-Carlo dropout: forces (samples, R, len(axes)) with dropout left on at prediction.
+
+    The dropout masks come from a forked, seeded torch generator (no global state changes).
+    """
+    x = scaling.inputs(inputs)
+    out = np.empty((samples, len(x), len(axes)))
+    for j, a in enumerate(axes):
+        i = "XYZ".index(a)
+        model = nets[a].model
+        model.train()
+        try:
+            with torch.random.fork_rng(devices=[]):
+                torch.manual_seed(seed)
+                for k in range(samples):
+                    out[k, :, j] = scaling.force_inverse(nets[a].predict(x)[:, 0], i)
+        finally:
+            model.eval()
+    return out

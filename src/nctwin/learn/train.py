@@ -37,11 +37,8 @@ Checkpoints
 from __future__ import annotations
 
 import copy
-import hashlib
-import json
 import math
 import os
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
@@ -51,7 +48,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from . import paths
+from ..cache import atomic_write, cache_path, content_key
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
@@ -233,16 +230,7 @@ class Trained:
 
 def data_hash(xs: Sequence[np.ndarray], ys: Sequence[np.ndarray]) -> str:
     """SHA-256 of the training data (shapes and bytes of every array, in order)."""
-    h = hashlib.sha256()
-    for a in (*xs, *ys):
-        a = np.ascontiguousarray(a, dtype=np.float64)
-        h.update(str(a.shape).encode())
-        h.update(a.tobytes())
-    return h.hexdigest()
-
-
-def _checkpoint_path(name: str, key: str) -> Path:
-    return paths.cache_dir() / "models" / f"{name}-{key[:16]}.pt"
+    return content_key(*(np.asarray(a, dtype=np.float64) for a in (*xs, *ys)))
 
 
 def _split(n_programs: int, cfg: TrainConfig) -> tuple[np.ndarray, np.ndarray]:
@@ -340,8 +328,7 @@ def fit(
            "train": train_config.to_dict()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
-    key_src = json.dumps(key, sort_keys=True)
-    path = _checkpoint_path(name, hashlib.sha256(key_src.encode()).hexdigest())
+    path = cache_path("models", name, content_key(key), ".pt")
     if cache and path.exists():
         return load_checkpoint(path)
 
@@ -460,7 +447,6 @@ def _scaler_of(d: dict) -> Scaler:
 def save_checkpoint(trained: Trained) -> Path:
     """Write ``trained`` to its path atomically (temporary file in the folder, then rename)."""
     path = trained.path
-    path.parent.mkdir(parents=True, exist_ok=True)
     payload = {
         "model_type": type(trained.model.config).__name__,
         "model_config": trained.model.config.to_dict(),
@@ -472,15 +458,7 @@ def save_checkpoint(trained: Trained) -> Path:
         "best_epoch": trained.best_epoch,
         "train_seconds": trained.train_seconds,
     }
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        torch.save(payload, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return atomic_write(path, lambda tmp: torch.save(payload, tmp))
 
 
 def load_checkpoint(path: str | os.PathLike) -> Trained:

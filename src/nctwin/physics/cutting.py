@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_range
+from ..checks import check_range
 
 __all__ = [
     "C45",

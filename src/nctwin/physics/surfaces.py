@@ -203,7 +203,7 @@ class Sphere:
     :math:`S(u, v) = \rho\,(\sin\theta\cos\phi, \sin\theta\sin\phi, \cos\theta)` with polar angle
     :math:`\theta = \theta_0 + u\,\Delta\theta` and azimuth :math:`\phi = 2\pi v`: every
     iso-:math:`v` line is an arc of a great circle, so the step error has the closed form of
-    :func:`nctwin.steperror.chord_step_error_um`.
+    :func:`nctwin.physics.steperror.chord_step_error_um`.
 
     Parameters
     ----------

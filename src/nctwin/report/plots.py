@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .machine import MachineProfile
-from .motion import Motion
-from .toolpath import MotionKind, Toolpath
+from ..machine import MachineProfile
+from ..motion import Motion
+from ..toolpath import MotionKind, Toolpath
 
 __all__ = ["commanded_feed_mm_s", "feed_profile"]
 

@@ -1,4 +1,9 @@
-"""What a measuring system sees of a motion: a controller's data sampled slowly and unevenly.
+"""What a measuring system sees of a motion: a real control's recorded trace, and a controller's
+data sampled slowly and unevenly.
+
+A real control records its axes' actual positions, which lag its command: :class:`Recording`
+adds a first-order position loop (servo lag, with the wait for the in-position window at the end)
+and encoder noise to a kernel's command positions (Chien et al. 2023, "machine B").
 
 Sun et al. (2022, Sec. 4.1) read the actual axis feeds of a Siemens 840D at about 5 Hz: 901
 samples against 5383 cutter locations. :func:`controller_samples` samples a kernel's Motion the
@@ -12,10 +17,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import lfilter
 
-from .motion import Motion
+from ..motion import Motion
 
-__all__ = ["ControllerSamples", "controller_samples", "nearest_sample"]
+__all__ = ["ControllerSamples", "Recording", "controller_samples", "nearest_sample"]
 
 
 @dataclass(frozen=True)
@@ -97,3 +103,53 @@ def nearest_sample(
     d2 = ((samples.pos_mm[cand] - points_mm[:, None, :]) ** 2).sum(axis=2)
     d2[np.abs(samples.t_s[cand] - passage_s[:, None]) > window_s] = np.inf
     return cand[np.arange(len(points_mm)), np.argmin(d2, axis=1)]
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What a real control's recorded trace adds to the kernel's command positions.
+
+    Parameters
+    ----------
+    position_gain_1_s : float
+        Gain ``Kv`` of a first-order position loop per axis (1/s); the actual position lags the
+        command by ``F / Kv``, in time by ``1 / Kv``, and so do the recorded block labels. 0: no
+        lag (the simulation profile).
+    in_position_mm : float
+        The motion ends when every axis is this close to the end point.
+    noise_mm : float
+        Standard deviation of the encoder noise on every recorded position.
+    seed : int
+        Seed of the noise (combined with the program's index).
+    """
+
+    position_gain_1_s: float = 0.0
+    in_position_mm: float = 0.001
+    noise_mm: float = 0.0
+    seed: int = 0
+
+    def apply(self, motion: Motion, rng: np.random.Generator) -> Motion:
+        """The recorded motion: lagged, extended until in position, noisy; the block labels
+        delayed by the following time."""
+        ts = motion.period_s
+        pos = motion.pos_mm
+        block = motion.block
+        if self.position_gain_1_s > 0:
+            a = 1.0 - np.exp(-self.position_gain_1_s * ts)
+            # settle: the lag decays by (1 - a) per sample from at most the largest lag
+            lag_mm = np.abs(pos - np.roll(pos, 1, axis=0))[1:].max(initial=0.0) / a
+            extra = int(np.ceil(np.log(self.in_position_mm / max(lag_mm, 1e-12)) / np.log(1 - a)))
+            extra = max(extra, 0)
+            cmd = np.vstack([pos, np.repeat(pos[-1:], extra, axis=0)])
+            # y[n] = (1 - a) y[n-1] + a x[n-1], at rest on the first command position
+            pos = np.column_stack(
+                [lfilter([0.0, a], [1.0, a - 1.0], cmd[:, i], zi=cmd[:1, i])[0] for i in range(3)]
+            )
+            delay = round(1.0 / a)  # the loop's following time in samples (1 / Kv as ts -> 0)
+            block = np.concatenate([np.full(delay, block[0]), block, np.full(extra, block[-1])])
+            block = block[: len(pos)]
+        if self.noise_mm > 0:
+            pos = pos + rng.normal(0.0, self.noise_mm, pos.shape)
+        vel = np.zeros_like(pos)
+        vel[1:] = np.diff(pos, axis=0) / ts
+        return Motion(np.arange(len(pos)) * ts, pos, vel, block, ts)

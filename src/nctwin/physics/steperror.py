@@ -107,10 +107,10 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4, max_steps: int = 60) ->
               \tfrac12 (d^2)'' = c_u \cdot c_u + w \cdot c_{uu} - (a \cdot c_u)^2
               - (w \cdot a)(a \cdot c_{uu}),
 
-    from the surface's curve jet (e.g. :meth:`nctwin.surfaces.BumpSurface.curve_jet`). The ends
-    of the segment are candidates too, at no cost (:math:`c(u_i) = CC_i`): near an inflection
-    :math:`d` can be monotone on a segment, and where :math:`F'` does not change sign between
-    the ends (read off the end normals, no evaluation) the extreme is at an end. Newton
+    from the surface's curve jet (e.g. :meth:`nctwin.physics.surfaces.BumpSurface.curve_jet`).
+    The ends of the segment are candidates too, at no cost (:math:`c(u_i) = CC_i`): near an
+    inflection :math:`d` can be monotone on a segment, and where :math:`F'` does not change sign
+    between the ends (read off the end normals, no evaluation) the extreme is at an end. Newton
     converges quadratically: after a step :math:`\delta` the parameter misses the extreme by
     about :math:`|F'''/(2F'')|\,\delta^2`, and the value by :math:`\tfrac12 |F''|` times the
     square of that. On the paper's surfaces three steps from the middle stop 98 % of the

@@ -1,0 +1,104 @@
+"""Report a chapter's claims: write ``results/<stem>/claims.json`` and print each claim.
+
+Every chapter ends with one call,
+
+.. code-block:: python
+
+    report_claims(STEM, chapter.claims(...));
+
+where ``chapter.claims`` builds the chapter's :class:`~nctwin.report.tables.Claim` list from its
+tables. A failing claim is reported (``FAILS``), never asserted away.
+
+The printed line is :data:`LINE` with :data:`VERDICTS` unless a chapter keeps its own (the
+chapters were written with slightly different lines, and their checked outputs stay as they
+are); ``table=True`` prints the claims as a table instead, one row per
+:meth:`~nctwin.report.tables.Claim.to_dict` record.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import pandas as pd
+
+from .tables import Claim, format_table, write_claims
+
+__all__ = ["LINE", "VERDICTS", "Claim", "format_claim", "report_claims"]
+
+#: The line printed per claim: ``str.format`` fields ``verdict``, ``id``, ``text``, ``value``,
+#: ``op`` and ``threshold``.
+LINE = "{verdict}  {id}: {value:.2f} {op} {threshold:g}"
+#: The verdict words: (claim holds, claim fails).
+VERDICTS = ("holds", "FAILS")
+
+
+def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VERDICTS) -> str:
+    """One claim as a line of text.
+
+    Parameters
+    ----------
+    claim : Claim
+    line : str
+        ``str.format`` template with the fields ``verdict``, ``id``, ``text``, ``value``, ``op``
+        and ``threshold`` (``value`` and ``threshold`` are floats).
+    verdicts : tuple of str
+        The word for a claim that holds and for one that fails.
+
+    Returns
+    -------
+    str
+    """
+    return line.format(
+        verdict=verdicts[0] if claim.holds else verdicts[1],
+        id=claim.id,
+        text=claim.text,
+        value=claim.value,
+        op=claim.op,
+        threshold=claim.threshold,
+    )
+
+
+def report_claims(
+    stem: str,
+    claims: Iterable[Claim],
+    *,
+    line: str = LINE,
+    verdicts: tuple[str, str] = VERDICTS,
+    table: bool = False,
+    results_dir: Path | None = None,
+) -> list[Claim]:
+    """Write the claims to ``results/<stem>/claims.json`` and print them.
+
+    Parameters
+    ----------
+    stem : str
+        Notebook stem, e.g. ``"chien2023_bilstm"``.
+    claims : iterable of Claim
+        In the order they are written and printed; ids must be unique.
+    line, verdicts : str, tuple of str
+        How each claim is printed (:func:`format_claim`).
+    table : bool
+        Print one table of the claims' records (:func:`~nctwin.report.tables.format_table`)
+        instead of one line per claim.
+    results_dir : pathlib.Path, optional
+        Results folder; default ``paths.results_dir()``.
+
+    Returns
+    -------
+    list of Claim
+        The claims, whether they hold or not.
+
+    Raises
+    ------
+    ValueError
+        If two claims share an id (nothing is written).
+    """
+    claims = list(claims)
+    write_claims(stem, claims, results_dir=results_dir)
+    if table:
+        print(format_table(pd.DataFrame([c.to_dict() for c in claims])))
+    else:
+        for c in claims:
+            print(format_claim(c, line, verdicts))
+    return claims
