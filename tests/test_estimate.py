@@ -51,8 +51,12 @@ def test_cam_clamps_feed_to_the_machine_maximum():
 
 def test_inch_program_time():
     # 1 in at 60 in/min takes 1 s whatever the units
-    result = estimate(parse("G20 G1 X1 F60"), MACHINE, "cam")
+    result = estimate(parse("G20\nG1 X1 F60"), MACHINE, "cam")
     assert result.cycle_time_s == pytest.approx(1.0)
+    # on one line LinuxCNC sets F (60 mm/min, the program starts in mm) before it changes the
+    # units, and keeps the physical feed: 25.4 mm at 60 mm/min take 25.4 s
+    result = estimate(parse("G20 G1 X1 F60"), MACHINE, "cam")
+    assert result.cycle_time_s == pytest.approx(25.4)
 
 
 def test_unknown_method_is_named():

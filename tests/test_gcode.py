@@ -13,11 +13,26 @@ from nctwin import GCodeError, MotionKind, dump, parse
 
 
 def test_units_are_converted_to_mm():
-    tp = parse("G20 G1 X1 Y-0.5 F60\nG21 X10")
+    tp = parse("G20\nG1 X1 Y-0.5 F60\nG21 X10")
     np.testing.assert_allclose(tp.end_mm[0], [25.4, -12.7, 0])
     assert tp.feed_mm_s[0] == pytest.approx(25.4)  # 60 in/min = 1 in/s
     np.testing.assert_allclose(tp.end_mm[1], [10, -12.7, 0])
     assert tp.feed_mm_s[1] == pytest.approx(25.4)  # F keeps its value in mm/s after G21
+
+
+def test_f_is_set_before_the_units_change_of_its_line():
+    # LinuxCNC's order of execution: F (step 3) before G20/G21 (step 12), and
+    # convert_length_units keeps the feed in mm/min: 6 mm/min = 0.1 mm/s, not 6 in/min
+    tp = parse("G21\nG20 F6 G1 X1\nX2")
+    assert tp.feed_mm_s[0] == 0.1
+    assert tp.feed_mm_s[1] == 0.1
+    np.testing.assert_allclose(tp.end_mm[:, 0], [25.4, 50.8])
+    # the other way round: F6 in inch (2.54 mm/s) kept after G21; a later F is in mm/min
+    tp = parse("G21 F6 G1 X1", units="inch")
+    assert tp.feed_mm_s[0] == pytest.approx(6 * 25.4 / 60)
+    assert parse("G20\nG21 F6 G1 X1\nF6 X2").feed_mm_s.tolist() == pytest.approx([2.54, 0.1])
+    # G64 P runs after the units change: it is in the new units
+    assert parse("G21\nG20 G64 P0.01 G1 X1 F6").blend_tol_mm[0] == pytest.approx(0.254)
 
 
 def test_inch_arc_words_are_converted():
@@ -99,11 +114,11 @@ def test_program_g64_p_in_inch_is_converted():
         ("X1", 1, "without an active motion mode"),
         ("G80 X1", 1, "without an active motion mode"),
         ("G0 X1 I1", 1, "without an arc"),
-        ("O100 sub", 1, "O-words"),
-        ("#1 = 5", 1, "#parameters"),
-        ("G0 X[1+2]", 1, "expressions"),
-        ("G81 X0 Y0 Z-1 R1", 1, "canned cycles"),
-        ("G41 D1", 1, "cutter radius compensation"),
+        ("O100 sub", 1, "O-word (subroutine, loop or conditional) needs LinuxCNC's"),
+        ("#1 = 5", 1, "#-parameter needs LinuxCNC's interpreter"),
+        ("G0 X[1+2]", 1, "expression [...] needs LinuxCNC's interpreter"),
+        ("G81 X0 Y0 Z-1 R1", 1, "G81 with no feed rate set (F)"),
+        ("G41 D1", 1, "G41 cutter compensation needs LinuxCNC's interpreter: run make linuxcnc"),
         ("G0 A10", 1, "axis A"),
         ("G1 X1 F60\nG93", 2, "inverse-time"),
         ("G0 X1 (unclosed", 1, "unbalanced parentheses"),
@@ -113,9 +128,10 @@ def test_program_g64_p_in_inch_is_converted():
         ("G0 X-+1", 1, "malformed number"),
         ("G0 X1\n5", 2, "number without a word letter"),
         ("G0 X1\nG4", 2, "without a dwell time"),
-        ("G4 P1 X1 Y1", 1, "cannot share a line with motion"),
+        ("G4 X1 Y1", 1, "cannot share a line with motion"),
+        ("G4 P1 X1 Y1", 1, "without an active motion mode"),
         ("G1 X1 F0", 1, "F must be > 0"),
-        ("G1 X1 F60 P2", 1, "P word without G4 or G64"),
+        ("G1 X1 F60 P2", 1, "P word without G2, G3, G4, G64 or a canned cycle"),
         ("G0 X1é", 1, "non-ASCII"),
         ("G1.7 X1", 1, "G1.7 is not supported"),
         ("G0 X1" + "9" * 400, 1, "out of range"),
@@ -211,7 +227,7 @@ def test_round_trip_parse_dump_parse(text):
     assert again.length_mm == pytest.approx(tp.length_mm, rel=1e-9, abs=1e-9)
 
 
-_GCODE_ALPHABET = "GXYZIJKRFPQMSTNOgx0123456789.-+ \t\n()%;/#[]=é"
+_GCODE_ALPHABET = "GXYZIJKRFPQLMSTNOgx0123456789.-+ \t\n()%;/#[]=é"
 
 
 @given(st.one_of(st.text(max_size=300), st.text(alphabet=_GCODE_ALPHABET, max_size=300)))

@@ -14,7 +14,7 @@ from nctwin.machine import load_machine
 SUFFIXES = (".ngc", ".nc", ".gcode")
 PROGRAMS = sorted(p.name for p in SHARED_PROGRAMS.glob("*") if p.suffix in SUFFIXES)
 #: The programs nctwin rejects, and the construct it must name.
-REJECTED = {"3D_Chips.ngc": (9, "#parameters are not supported")}
+REJECTED = {"3D_Chips.ngc": (9, "#-parameter needs LinuxCNC's interpreter: run make linuxcnc")}
 
 
 @pytest.mark.parametrize("name", PROGRAMS or ["<none>"])

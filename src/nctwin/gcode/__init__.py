@@ -1,0 +1,59 @@
+"""G-code (RS274/NGC subset of a 3-axis mill) to :class:`~nctwin.toolpath.Toolpath` and back.
+
+The reader is vectorised: the text is lexed into words with numpy on the raw bytes, modal state is
+carried forward with cumulative maxima, and positions with anchored cumulative sums. Nothing loops
+over lines in Python, which is what makes it fast (see ``benchmarks/parse.py``). Only the rare
+constructs that carry state from line to line in ways a cumulative sum cannot (G92 offsets and
+canned cycles) are interpreted line by line, and only on the lines that hold them.
+
+What is read
+------------
+The words of a line run in LinuxCNC's order of execution, not in the order they are written:
+F, S, T and the spindle M-codes first, then the dwell G4, the plane, units, path control and
+distance modes, G98/G99, the G92 offsets, the motion, and last the stops M0, M1, M2, M30 and M60
+(their events follow the line's blocks). So ``G4 P1 G0 X1`` dwells, then moves; ``G20 F6`` in a
+program in G21 sets 6 mm/min and keeps it when the units change (LinuxCNC rescales the feed rate
+in ``convert_length_units``).
+
+* Motion G0, G1, G2, G3: I/J/K centres, R radii of both signs, helices, full circles (also with
+  no end-point words, ``G2 I5``), P turns (an arc of P turns is read as P-1 full turns then the
+  arc). Dwell G4 (P in seconds by default, ``dwell_p_unit="ms"`` for Fanuc-style milliseconds;
+  a G4 with X and no P is a Fanuc dwell of X seconds), alone or before the motion of its line.
+* Canned cycles G73, G74, G81-G89 with G98/G99 and R, Q, P, L words, in the G17, G18 and G19
+  planes, expanded into the rapids, feeds and dwells LinuxCNC 2.9 makes of them
+  (``interp_cycles.cc``): every block keeps the line of the cycle, runs in exact-path mode as in
+  LinuxCNC (but a first rapid up to R from below it, which LinuxCNC makes before switching), and
+  G73/G83 retract by LinuxCNC 2.9's ``G83_RAPID_DELTA`` (0.010 in). G74 and G84 are read in the
+  G17 plane only (in the others LinuxCNC 2.9 feeds along swapped axes). Before any G98/G99 the
+  tool retracts to R (LinuxCNC's retract mode starts as its zero value, G99). Spindle stops,
+  reversals and orientations inside G74, G84, G86, G87 and G88 have no motion effect and make no
+  events; G88 leaves the tool at the hole bottom for the operator and the next move starts
+  there, while the coordinates continue from the clearance height as in LinuxCNC.
+* Offsets G92, G92.1 (clears them and zeros parameters 5211-5213), G92.2 (clears them, keeps the
+  parameters), G92.3 (restores them from the parameters, which start at zero). Positions are
+  machine positions: program coordinates plus the G92 offset.
+* Modal state: G17/G18/G19, G20/G21 (converted to mm), G90/G91, G90.1/G91.1, G94, G98/G99, F.
+  A G80 beside another motion code of its line gives way to it, as in LinuxCNC (``read_g``).
+* Prologue codes kept as state with no motion: G40, G43 (H; tool lengths are taken as zero),
+  G49, G53 (machine coordinates, ignoring G92; work offsets are taken as zero), G54-G59.3, G80,
+  G61, G61.1 and G64 with P (blending tolerance) and Q (naive CAM tolerance).
+* N numbers, ``( )`` and ``;`` comments, block delete ``/`` (off by default: the block runs, as
+  with the switch off), ``%`` tape markers, Fanuc program numbers (a line that is only ``O1234``
+  and a comment), M, S and T words (kept as events), any case, with or without spaces. M2 and M30
+  end the program: what follows is not read, as on a control.
+
+Anything else LinuxCNC reads (O-word subroutines and loops, ``#`` parameters, expressions, cutter
+compensation, ...) raises :class:`GCodeError` with ``<construct> needs LinuxCNC's interpreter:
+run make linuxcnc``; rotary axes and codes LinuxCNC lacks are refused too. Every error of a file
+is reported, up to 20, one ``file:line: reason`` line each.
+"""
+
+from ._cycles import G83_RAPID_DELTA_IN as G83_RAPID_DELTA_IN
+from ._dump import dump
+from ._errors import MAX_ERRORS as MAX_ERRORS
+from ._errors import GCodeError
+from ._modal import MAX_BLOCKS_PER_LINE as MAX_BLOCKS_PER_LINE
+from ._modal import MM_PER_INCH as MM_PER_INCH
+from ._reader import parse, parse_file
+
+__all__ = ["GCodeError", "dump", "parse", "parse_file"]

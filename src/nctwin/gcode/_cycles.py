@@ -1,0 +1,328 @@
+"""G92 offsets and canned cycles (G73, G74, G81-G89): the constructs that carry state from line
+to line in ways a cumulative sum cannot, interpreted one by one on the lines that hold them, as
+LinuxCNC 2.9 does (``convert_axis_offsets`` in interp_convert.cc, interp_cycles.cc)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..toolpath import PLANE_AXES, MotionKind
+from ._errors import _NEEDS_LINUXCNC
+from ._modal import (
+    _DWELLS,
+    _IS_CYCLE,
+    _IS_G92,
+    _MOTION,
+    _NONMODAL,
+    MAX_BLOCKS_PER_LINE,
+    MM_PER_INCH,
+    _anchored,
+    _ffill,
+    _fmt_g,
+)
+
+#: LinuxCNC 2.9's G73/G83 retract above the last peck (``G83_RAPID_DELTA``, interp_internal.hh).
+G83_RAPID_DELTA_IN = 0.010
+
+
+@dataclass(frozen=True)
+class _Lines:
+    """Per-line words and modal state, the input of the line-by-line parts of the reader.
+
+    ``W[letter]`` is the value of each line's word (NaN where absent), ``has[letter]`` its
+    presence; the other fields hold the modal state in force at each line, after its own codes.
+    """
+
+    W: dict
+    has: dict
+    G: np.ndarray  # (groups, n): the G-code of each group on each line, -1 if none
+    scale: np.ndarray  # mm per program unit
+    motion: np.ndarray
+    plane: np.ndarray
+    incremental: np.ndarray
+    retract_r: np.ndarray  # G99 (retract to R), else G98
+    spindle: np.ndarray  # +1 clockwise, -1 counter-clockwise, 0 stopped
+    p_scale: float
+
+
+class _LineError(Exception):
+    """A line that cannot be interpreted (raised and caught inside the reader)."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class _Sticky:
+    """The words a canned cycle keeps for later lines of the same cycle, in program units (P in
+    seconds). LinuxCNC's ``cycle_p`` starts at 0 (a G84 without P dwells 0 s)."""
+
+    r: float = np.nan
+    depth: float = np.nan
+    p: float = 0.0
+    q: float = np.nan
+    ijk: tuple[float, float, float] = (np.nan, np.nan, np.nan)
+
+
+def _special_positions(L: _Lines, axis_given, axis_val, cycle_line, moves, start, errors, cycles):
+    """Machine positions of a program with G92 offsets or canned cycles, and the offsets.
+
+    Positions are followed in program coordinates (in mm), as LinuxCNC follows them, and the
+    offsets added at the end, so that the arithmetic is LinuxCNC's. The G92 and cycle lines are
+    interpreted one by one, in order (the blocks of each cycle go to ``cycles``, keyed by line);
+    the positions of the other lines are anchored sums, as in the common case, whose anchors
+    are filled in as the loop goes. A cycle works in program units, as LinuxCNC's: it starts
+    from the number the program gave where there is one (a word, or the end of a cycle, in the
+    same units and with no incremental step since).
+    """
+    n = len(L.scale)
+    nonmodal = L.G[_NONMODAL]
+    g53 = nonmodal == 530  # machine coordinates: program coordinates minus the G92 offset
+    g92 = np.stack([L.has[x] for x in "XYZ"], axis=1) & (nonmodal == 920)[:, None]
+    anchor = (
+        (axis_given & ~L.incremental[:, None])
+        | (cycle_line | _IS_G92[nonmodal] & (nonmodal != 920))[:, None]  # every axis moves
+        | g92
+    )
+    step = np.where(axis_given & L.incremental[:, None] & ~cycle_line[:, None], axis_val, 0.0)
+    csum = np.cumsum(step, axis=0)
+    last = np.where(anchor, np.arange(n)[:, None], -1)
+    np.maximum.accumulate(last, axis=0, out=last)
+    aval = axis_val.copy()  # the program coordinate of each anchor
+    uval = np.stack([L.W[x] for x in "XYZ"], axis=1)  # ... in its line's units, where exact
+    uval[g53] = np.nan
+    n_steps = np.cumsum(step != 0.0, axis=0)
+    off = np.zeros((n, 3))  # the G92 offsets in force at each line
+
+    def before(k: int) -> np.ndarray:
+        """Program coordinates before line k."""
+        p = start.copy()
+        for a in range(3):
+            j = last[k - 1, a] if k else -1
+            if j >= 0:
+                p[a] = aval[j, a] + (csum[k - 1, a] - csum[j, a])
+            elif k:
+                p[a] = start[a] + (csum[k - 1, a] - 0.0)
+        return p
+
+    def in_units(k: int, cur: np.ndarray) -> np.ndarray:
+        """Program coordinates ``cur`` (mm) before line k, in its units, exactly where known."""
+        u = cur / L.scale[k]
+        for a in range(3):
+            j = last[k - 1, a] if k else -1
+            if j >= 0 and n_steps[k - 1, a] == n_steps[j, a] and L.scale[j] == L.scale[k]:
+                u[a] = u[a] if np.isnan(uval[j, a]) else uval[j, a]
+        return u
+
+    # a motion other than a canned cycle resets the cycles' initial level
+    resets = np.cumsum((L.G[_MOTION] >= 0) & ~_IS_CYCLE[L.G[_MOTION]] | (moves & ~cycle_line))
+    o, saved = np.zeros(3), np.zeros(3)  # G92 offsets, and parameters 5211-5213 (mm)
+    il, sticky, last_cycle = None, _Sticky(), -1
+    for k in np.flatnonzero(cycle_line | _IS_G92[nonmodal]):
+        cur = before(k)
+        if _IS_G92[nonmodal[k]]:  # interp_convert.cc, convert_axis_offsets
+            if nonmodal[k] == 920:  # the current point gets the given coordinates
+                new = (cur + o) - axis_val[k]
+                o = np.where(g92[k], new, o)
+                saved = o.copy()
+                cur = np.where(g92[k], axis_val[k], cur)
+            elif nonmodal[k] == 923:  # back to the offsets kept in the parameters
+                cur = (cur + o) - saved
+                o = saved.copy()
+            else:  # G92.1 clears the parameters too, G92.2 keeps them
+                cur = cur + o
+                o = np.zeros(3)
+                saved = saved if nonmodal[k] == 922 else np.zeros(3)
+            off[k:] = o
+            aval[k:][g53[k:]] = axis_val[k:][g53[k:]] - o
+            aval[k] = cur
+            if nonmodal[k] != 920:
+                uval[k] = np.nan
+            if not cycle_line[k]:  # the motion of the line, after the offsets
+                given = axis_given[k]
+                aval[k, given] = np.where(
+                    L.incremental[k], cur[given] + axis_val[k, given], axis_val[k, given]
+                )
+                if not L.incremental[k]:
+                    uval[k, given] = np.array([L.W[x][k] for x in "XYZ"])[given]
+        if cycle_line[k]:
+            if last_cycle >= 0 and resets[k - 1] > resets[last_cycle]:
+                il = None
+            units = cur / L.scale[k] if _IS_G92[nonmodal[k]] else in_units(k, cur)
+            try:
+                blocks, uval[k], il, sticky = _cycle(L, k, units, off[k], il, sticky)
+            except _LineError as exc:
+                errors.at_lines(np.array([k]), exc.reason)
+                aval[k], uval[k] = cur, np.nan
+            else:
+                aval[k] = uval[k] * L.scale[k]
+                cycles[int(k)] = blocks
+            last_cycle = k
+    pos = np.empty((n, 3))
+    for a in range(3):
+        prog = _anchored(anchor[:, a], aval[:, a], step[:, a], start[a])
+        # a line without motion leaves the tool where it is, whatever its offsets
+        pos[:, a] = _ffill(moves, prog + off[:, a], start[a])
+    return pos, off
+
+
+def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
+    """The moves of the canned cycle of line ``k``, as LinuxCNC 2.9 makes them.
+
+    Follows interp_cycles.cc: ``convert_cycle`` and ``convert_cycle_xy`` (and its _yz, _zx
+    twins, here one function over the plane's axes), the CYCLE_MACRO repeat loop and the
+    ``convert_cycle_g*`` functions. The computation runs in program units and coordinates, as
+    LinuxCNC's; each point is then converted to machine millimetres, adding the G92 offset as
+    LinuxCNC's canon does.
+
+    Parameters
+    ----------
+    L : _Lines
+    k : int
+        Line index.
+    cur, off : ndarray, shape (3,)
+        Program coordinates before the line (program units), and the G92 offset (mm).
+    il : float or None
+        The initial level (program units) LinuxCNC keeps from the first of a run of cycles
+        (``cycle_il``), None when a motion other than a cycle came since.
+    sticky : _Sticky
+
+    Returns
+    -------
+    blocks : list of (kind, point mm (3,), dwell s, exact path)
+    end : ndarray, shape (3,)
+        The program coordinates after the line (program units, at the clearance height).
+    il : float
+    sticky : _Sticky
+
+    Raises
+    ------
+    _LineError
+        With LinuxCNC's reason, where it refuses the line.
+    """
+    c, name = int(L.motion[k]), _fmt_g(int(L.motion[k]))
+    s = float(L.scale[k])
+    a, b, nrm = PLANE_AXES[L.plane[k]]
+    W = {x: float(L.W[x][k]) for x in "XYZIJKRPQL"}
+    has = {x: bool(L.has[x][k]) for x in "XYZIJKRPQL"}
+    same = k > 0 and L.motion[k - 1] == c  # the same cycle ran last: its words carry over
+    depth_letter = "XYZ"[nrm]
+
+    def word(letter: str, kept: float, missing: str) -> float:
+        if has[letter]:
+            return W[letter]
+        if same:
+            return kept
+        raise _LineError(missing)
+
+    if c in (740, 840) and a != 0:  # convert_cycle_g74_g84 maps the plane's axes a second time
+        raise _LineError(
+            f"{name} in the G{17 + L.plane[k]} plane (whose feeds LinuxCNC 2.9 sends along swapped"
+            f" axes) {_NEEDS_LINUXCNC}"
+        )
+    r_word = word("R", sticky.r, f"R clearance plane unspecified in {name}")
+    depth = word(depth_letter, sticky.depth, f"{depth_letter} value unspecified in {name}")
+    if il is None:
+        il = float(cur[nrm])
+    old = il
+    if L.incremental[k]:
+        step = [W["XYZ"[x]] if has["XYZ"[x]] else 0.0 for x in (a, b)]
+        r = r_word + old
+        bottom = r + depth
+        aa, bb = float(cur[a]), float(cur[b])
+    else:
+        step = [0.0, 0.0]
+        r, bottom = r_word, depth
+        aa, bb = (W["XYZ"[x]] if has["XYZ"[x]] else float(cur[x]) for x in (a, b))
+    if r < bottom:
+        raise _LineError(f"R less than {depth_letter} in {name}")
+    p, q, ijk = sticky.p, sticky.q, sticky.ijk
+    if _DWELLS[c]:  # (tapping may go without P: it dwells the P kept, 0 at first)
+        if not (has["P"] or same or c in (740, 840)):
+            raise _LineError(f"dwell time P word missing with {name}")
+        p = W["P"] * L.p_scale if has["P"] else sticky.p
+    elif c in (730, 830):
+        q = word("Q", sticky.q, f"Q word missing with {name}")
+        if not q > 0:
+            raise _LineError(f"negative or zero Q value used in {name}")
+    elif c == 870:
+        ijk = tuple(
+            word(x, v, f"{x} word missing with G87") for x, v in zip("IJK", ijk, strict=True)
+        )
+    spindle = L.spindle[k]
+    if c in (860, 870, 880, 740, 840) and spindle == 0:
+        raise _LineError(f"spindle not turning in {name}")
+    if (c, spindle) in ((840, -1), (740, 1)):
+        turning = "counterclockwise" if spindle == -1 else "clockwise"
+        raise _LineError(f"spindle turning {turning} in {name}")
+    repeats = int(np.rint(W["L"])) if has["L"] else 1
+    per_repeat = 12 + (3 * (r - bottom) / q if c in (730, 830) else 0)
+    values = (r, bottom, aa, bb, *step, per_repeat)
+    if not (np.isfinite(values).all() and repeats * per_repeat <= MAX_BLOCKS_PER_LINE):
+        raise _LineError(f"{name} would make more than {MAX_BLOCKS_PER_LINE} moves")
+
+    blocks = []
+    at = np.zeros(3)  # program coordinates of the last point
+
+    def go(kind: MotionKind, u: float, v: float, w: float, exact: bool = True) -> None:
+        at[[a, b, nrm]] = u, v, w
+        blocks.append((kind, at * s + off, 0.0, exact))
+
+    def dwell(t: float) -> None:
+        blocks.append((MotionKind.DWELL, at * s + off, t, True))
+
+    rapid, feed = MotionKind.RAPID, MotionKind.LINEAR
+    current = float(cur[nrm])
+    at[:] = cur
+    if old < r:  # below the R plane: straight up to it first (before the exact-path mode is set)
+        go(rapid, cur[a], cur[b], r, exact=False)
+        old = current = r
+    clear = r if L.retract_r[k] else old
+    delta = G83_RAPID_DELTA_IN * (1.0 if s == MM_PER_INCH else MM_PER_INCH)
+    for repeat in range(repeats):  # CYCLE_MACRO
+        aa, bb = aa + step[0], bb + step[1]
+        if repeat == 0 and current > r:
+            go(rapid, aa, bb, current)
+            go(rapid, aa, bb, r)
+        else:
+            go(rapid, aa, bb, clear)
+            if clear > r:
+                go(rapid, aa, bb, r)
+        if c in (730, 830):  # peck drilling: chip breaking (G73) or full retract (G83)
+            depth_now = r - q
+            while depth_now > bottom:
+                go(feed, aa, bb, depth_now)
+                if c == 830:
+                    go(rapid, aa, bb, r)
+                go(rapid, aa, bb, depth_now + delta)
+                depth_now = depth_now - q
+            go(feed, aa, bb, bottom)
+            go(rapid, aa, bb, clear)
+        elif c == 870:  # back boring, in and out off centre by I/J with the spindle oriented
+            oa, ob = aa + ijk[a], bb + ijk[b]
+            middle = ijk[nrm] + (bottom if L.incremental[k] else 0.0)
+            go(rapid, oa, ob, r)
+            go(rapid, oa, ob, bottom)
+            go(rapid, aa, bb, bottom)
+            go(feed, aa, bb, middle)
+            go(feed, aa, bb, bottom)
+            go(rapid, oa, ob, bottom)
+            go(rapid, oa, ob, clear)
+            go(rapid, aa, bb, clear)
+        else:
+            go(feed, aa, bb, bottom)
+            if c == 850:  # feed out to R, then rapid
+                go(feed, aa, bb, r)
+            if _DWELLS[c]:
+                dwell(p)
+            if c in (740, 840, 890):  # tapping and boring: feed out
+                go(feed, aa, bb, clear)
+            elif c != 880:  # G88: the operator takes the tool out at a program stop
+                go(rapid, aa, bb, clear)
+    end = np.zeros(3)
+    end[[a, b, nrm]] = aa, bb, clear
+    sticky = replace(sticky, r=r_word, depth=depth, p=p, q=q, ijk=ijk)
+    return blocks, end, il, sticky
