@@ -1,7 +1,9 @@
 # nctwin — reproducibility package for five NC-machining papers.
 #
-#   make reproduce   set up .venv, execute every notebook, build the book (HTML)
-#   make test        what CI runs (.ci/run): LinuxCNC, lint, unit tests, nbval, book, browser check
+#   make reproduce   set up .venv, execute every notebook, build the book (HTML); one line per
+#                    step, "[k/N] ... (last run ...)", with the step's duration from the last run
+#   make test        what CI runs (.ci/run): LinuxCNC, lint, unit tests, nbval (and that it leaves
+#                    results/ as it found it), book, browser check
 #
 # Everything runs through .venv/bin/... explicitly; nothing needs `source activate`.
 # Only PyPI (pip), Debian (apt) and npm are used; nothing is downloaded while notebooks run.
@@ -34,6 +36,9 @@ export TZ := UTC
 export JUPYTER_PREFER_ENV_PATH := 1
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# Plain logs: no ANSI colour codes from pytest, ruff, pip or IPython tracebacks.
+export NO_COLOR := 1
+export TERM := dumb
 
 # Same numbers on every x86-64 CPU with AVX2: numpy, OpenBLAS, torch (ATen, MKL, oneDNN) pick
 # their kernels by CPU, and AVX-512 kernels round differently from AVX2 ones (trained networks
@@ -111,12 +116,16 @@ mathjax:
 	rm -rf $$tmp; echo "$(MATHJAX_VERSION)" > $(MATHJAX_DIR)/VERSION; \
 	echo "mathjax: MathJax $(MATHJAX_VERSION) es5/ -> $(MATHJAX_DIR)"
 
+# apt-get waits for a dpkg/apt lock another apt run holds (up to 10 min) instead of failing.
+APT_WAIT := -o DPkg::Lock::Timeout=600
+
 chromium:
 	@if [ -x $(CHROMIUM) ]; then echo "chromium: $(CHROMIUM) present"; exit 0; fi; \
 	sudo=; [ "$$(id -u)" = 0 ] || sudo=sudo; \
-	echo "chromium: installing Debian chromium with apt-get"; \
-	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q; \
-	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends chromium
+	echo "chromium: installing Debian chromium with apt-get (waits up to 10 min for another apt run)"; \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get $(APT_WAIT) update -q; \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get $(APT_WAIT) install -y -q \
+	  --no-install-recommends chromium
 
 # ---------------------------------------------------------------------------------------------
 # linuxcnc: the real NC kernel of nctwin.kernel.linuxcnc. Debian packages without recommends
@@ -133,8 +142,8 @@ linuxcnc:
 	sudo=; [ "$$(id -u)" = 0 ] || sudo=sudo; t0=$$(date +%s); \
 	if ! have; then \
 	  echo "linuxcnc: installing $(LINUXCNC_PKGS) with apt-get (about 1 min)"; \
-	  if ! { $$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q && \
-	         $$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
+	  if ! { $$sudo env DEBIAN_FRONTEND=noninteractive apt-get $(APT_WAIT) update -q && \
+	         $$sudo env DEBIAN_FRONTEND=noninteractive apt-get $(APT_WAIT) install -y -q \
 	           --no-install-recommends $(LINUXCNC_PKGS); }; then \
 	    echo "linuxcnc: FAILED to install $(LINUXCNC_PKGS) with apt-get (Debian bookworm" \
 	         "packages; needs root or sudo and the network); see apt-get's message above" >&2; \
@@ -153,40 +162,85 @@ record: venv linuxcnc
 	echo "record: done in $$(( $$(date +%s) - t0 )) s"
 
 # ---------------------------------------------------------------------------------------------
+# Steps that talk: each long step prints "[k/N] <step> (last run 9 min 40 s)" before it starts,
+# with its duration from the last successful run on this machine, kept in $(DURATIONS) (build/
+# is not committed). STEP_SH defines the shell helpers the recipes below use:
+#   human S       "9 min 40 s"           last_run STEP   "last run 9 min 40 s" or "no previous run"
+#   record_s STEP SECONDS                stores the step's duration
+DURATIONS := build/durations.tsv
+STEP_SH := \
+  human() { if [ "$$1" -ge 60 ]; then echo "$$(( $$1 / 60 )) min $$(( $$1 % 60 )) s"; else echo "$$1 s"; fi; }; \
+  last_run() { local s=; [ -f $(DURATIONS) ] && s=$$(awk -F'\t' -v k="$$1" '$$1 == k { v = $$2 } END { print v }' $(DURATIONS)); \
+    if [ -n "$$s" ]; then echo "last run $$(human $$s)"; else echo "no previous run here"; fi; }; \
+  record_s() { mkdir -p $(dir $(DURATIONS)); \
+    { if [ -f $(DURATIONS) ]; then awk -F'\t' -v k="$$1" '$$1 != k' $(DURATIONS); fi; printf '%s\t%s\n' "$$1" "$$2"; } \
+      > $(DURATIONS).tmp; mv $(DURATIONS).tmp $(DURATIONS); };
+
+# ---------------------------------------------------------------------------------------------
 # notebooks: papermill, headless, cwd = repo root (notebooks write results/<stem>/...). The output
 # goes to build/papermill/ first and replaces book/notebooks/<name> only on success.
 # `make notebooks` re-executes all; `make book`/`make test` execute only those whose executed copy
 # is missing (order-only prerequisites: a fresh clone's file times never trigger a re-run).
 # Figures: the kernel draws inline only with this backend (the exported Agg would drop them);
 # progress bars stay out of the executed notebooks.
+# Papermill runs through its Python API, not its command line, for two settings the command line
+# lacks: the kernel talks to papermill over IPC sockets (with TCP, ipykernel warns on every start
+# that the transport is not encrypted), and IPython prints tracebacks without colour codes.
 NB_MPLBACKEND := module://matplotlib_inline.backend_inline
 NB_FORCE :=
-book/notebooks/%.ipynb: $(NB_FORCE) | notebooks/%.ipynb venv
+NB_VENV := venv
+STEP :=
+PAPERMILL_PY := import sys, papermill; from traitlets.config import Config; \
+  nb, out, cwd = sys.argv[1:]; \
+  papermill.execute_notebook(nb, out, cwd=cwd, kernel_name="python3", progress_bar=False, \
+    config=Config(KernelManager={"transport": "ipc"}), \
+    extra_arguments=["--InteractiveShell.colors=nocolor"])
+book/notebooks/%.ipynb: $(NB_FORCE) | notebooks/%.ipynb $(NB_VENV)
 	@mkdir -p book/notebooks build/papermill
-	@src=notebooks/$*.ipynb; tmp=build/papermill/$*.ipynb; t0=$$(date +%s); \
-	echo "notebooks: executing $$src"; \
-	if ! MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 \
-	     $(VENV)/bin/papermill --cwd "$(CURDIR)" -k python3 --no-progress-bar \
-	     "$$src" "$$tmp"; then \
+	@$(STEP_SH) src=notebooks/$*.ipynb; tmp=build/papermill/$*.ipynb; t0=$$(date +%s); \
+	echo "$(STEP)notebooks: executing $* ($$(last_run notebooks/$*))"; \
+	if ! MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -c '$(PAPERMILL_PY)' "$$src" "$$tmp" "$(CURDIR)"; then \
 	  echo "notebooks: $$src FAILED; the partly executed notebook is $$tmp" >&2; exit 1; \
 	fi; \
-	mv "$$tmp" "$@"; echo "notebooks: $@ ($$(( $$(date +%s) - t0 )) s)"
+	mv "$$tmp" "$@"; dt=$$(( $$(date +%s) - t0 )); record_s notebooks/$* $$dt; \
+	echo "notebooks: $@ ($$(human $$dt))"
 
 notebooks: venv
 	@if [ -z "$(strip $(EXECUTED))" ]; then echo "notebooks: notebooks/ holds no notebook"; exit 0; fi; \
-	$(MAKE) --no-print-directory NB_FORCE=FORCE $(EXECUTED)
+	n=$(words $(EXECUTED)); k=0; \
+	for nb in $(EXECUTED); do k=$$((k + 1)); \
+	  $(MAKE) --no-print-directory NB_FORCE=FORCE NB_VENV= STEP="[$$k/$$n] " $$nb; \
+	done
 
 FORCE:
 
 # ---------------------------------------------------------------------------------------------
-book: venv mathjax | $(EXECUTED)
+# book: the Verdicts page is written from results/*/claims.json first (nctwin.report.verdicts),
+# so the book always shows the claims its notebooks wrote. Jupyter Book colours Sphinx's messages
+# whatever NO_COLOR says; sed takes the colour codes out of the log.
+BOOK_SETUP := venv mathjax
+book: $(BOOK_SETUP) | $(EXECUTED)
 	@mkdir -p build; t0=$$(date +%s); \
-	$(VENV)/bin/jupyter-book build book --all -W --keep-going --builder html 2>&1 | tee build/book.log; \
+	$(PY) -m nctwin.report.verdicts book/verdicts.md; \
+	$(VENV)/bin/jupyter-book build book --all -W --keep-going --builder html 2>&1 \
+	  | sed -u 's/\x1b\[[0-9;]*m//g' | tee build/book.log; \
 	echo "book: built in $$(( $$(date +%s) - t0 )) s"; \
 	echo "book: $(CURDIR)/$(HTML_DIR)/index.html"
 
-reproduce: venv mathjax notebooks book
-	@echo "reproduce: done; open $(CURDIR)/$(HTML_DIR)/index.html"
+# reproduce: venv, MathJax, every notebook, the book; one "[k/N]" line per step.
+reproduce:
+	@$(STEP_SH) nbs=($(EXECUTED)); n=$$(( 3 + $${#nbs[@]} )); k=0; t_all=$$(date +%s); \
+	run() { local name=$$1; shift; k=$$((k + 1)); echo "[$$k/$$n] $$name ($$(last_run $$name))"; \
+	  local t0=$$(date +%s); $(MAKE) --no-print-directory "$$@"; record_s $$name $$(( $$(date +%s) - t0 )); }; \
+	run venv venv; \
+	run mathjax mathjax; \
+	for nb in "$${nbs[@]}"; do k=$$((k + 1)); \
+	  $(MAKE) --no-print-directory NB_FORCE=FORCE NB_VENV= STEP="[$$k/$$n] " $$nb; \
+	done; \
+	run book book BOOK_SETUP= NB_VENV=; \
+	total=$$(( $$(date +%s) - t_all )); \
+	echo "reproduce: done in $$(human $$total) ($$(last_run reproduce)); open $(CURDIR)/$(HTML_DIR)/index.html"; \
+	record_s reproduce $$total
 
 # ---------------------------------------------------------------------------------------------
 # make test installs LinuxCNC (make linuxcnc) and requires its live tests to run (they fail
@@ -203,12 +257,29 @@ unit: venv
 
 # nbval re-executes the notebooks in the environment papermill executed them in (inline figures,
 # no progress bars on stderr): a checked cell whose training outlasts the bar's delay would
-# otherwise print to stderr, which its executed copy does not have.
+# otherwise print to stderr, which its executed copy does not have. The re-execution rewrites
+# results/; nbval fails if any file there differs afterwards from what it was before (a copy
+# taken first, so uncommitted work is compared with itself, and a fresh clone with the commit).
 nbval: venv | $(EXECUTED)
 	@shopt -s nullglob; nbs=(book/notebooks/*.ipynb); \
 	if [ $${#nbs[@]} -eq 0 ]; then echo "nbval: book/notebooks/ holds no executed notebook; skipped"; exit 0; fi; \
 	echo "nbval: $${nbs[*]}"; \
-	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env -p no:cacheprovider "$${nbs[@]}"
+	snap=build/results-before-nbval; rm -rf $$snap; mkdir -p build; cp -a results $$snap; status=0; \
+	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env \
+	  -p no:cacheprovider --color=no "$${nbs[@]}" || status=$$?; \
+	changed=$$(diff -rq $$snap results | sed -E \
+	  -e "s#^Files $$snap/(.*) and results/.* differ\$$#  results/\1#" \
+	  -e "s#^Only in $$snap/?(.*): (.*)\$$#  results/\1/\2 (no longer written)#" \
+	  -e "s#^Only in results/?(.*): (.*)\$$#  results/\1/\2 (new)#" -e "s#results//#results/#" || true); \
+	rm -rf $$snap; \
+	if [ -n "$$changed" ]; then \
+	  echo "nbval: FAILED: re-executing the notebooks changed these files under results/:" >&2; \
+	  echo "$$changed" >&2; \
+	  echo "nbval: results/ must be reproducible bit for bit; measured timings belong elsewhere" \
+	       "(see README, 'Timings')" >&2; \
+	  exit 1; \
+	fi; \
+	exit $$status
 
 browser: book chromium
 	@t0=$$(date +%s); \

@@ -1,8 +1,10 @@
-"""Speed of Lee et al. 2022's analytic estimate and of the acc/dec kernel on the shipped
-ISO 10791-7-style test piece (over 30 minutes of cycle time, about 2000 blocks).
+"""Speed of Lee et al. 2022's analytic estimate on the shipped ISO 10791-7-style test piece
+(its natural length: 405 blocks, about 7.5 minutes of cycle time), and of the ideal acc/dec
+kernel it was derived for.
 
-Targets: the analytic estimate in under 20 ms (the paper: under 1 s; at least 50x faster), the
-kernel simulation in under 2 s.
+Targets: the analytic estimate in under 20 ms (the paper: under 1 s), the ideal kernel in under
+2 s. The chapter's measured machine, :mod:`nctwin.kernel.fanuc`, has its own benchmark
+(``benchmarks/fanuc.py``).
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from nctwin import parse
 from nctwin.kernel.accdec import measure_inposition_times, run, simulate
 from nctwin.machine import MachineProfile
+from nctwin.physics.servo import PositionLoop
 
 TI = 0.001
 FR = 10000.0 / 60.0  # rapid feed, mm/s
@@ -191,3 +192,14 @@ def test_kernel_ends_at_the_program_end_and_never_exceeds_f(segments, at_s):
     # arcs written with 4 decimals have start and end radii that differ by up to 1e-4 mm; the
     # kernel moves along that spiral at F over the arc's nominal length, hence the 1e-4 slack
     assert motion.speed_mm_s.max() <= fmax * (1 + 1e-4)
+
+
+def test_servo_is_the_packages_one_position_loop():
+    # the kernel's following error is what nctwin.physics.servo.PositionLoop makes of the
+    # command: X with Kp 80, Z with Kp 35, through a rapid, its in-position wait and a line
+    r = simulate(parse("G0 X30 Z-20\nG1 X40 Y5 F1200"), MACHINE)
+    cmd = r.motion.pos_mm
+    for axis, kp in enumerate(MACHINE.position_gain_per_s):
+        actual = PositionLoop("first_order_ff", kp).follow(cmd[:, axis], TI)
+        np.testing.assert_allclose(r.following_error_mm[:, axis], cmd[:, axis] - actual,
+                                   atol=1e-12)  # fmt: skip

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import io
 import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from nctwin.cli import main
@@ -115,3 +117,268 @@ def test_kernel_estimate_is_slower_than_cam(program, capsys):
     kernel = json.loads(capsys.readouterr().out)
     assert kernel["method"] == "kernel"
     assert kernel["cycle_time_s"] > cam
+
+
+# --- ordinary input, as a user meets it: one line on stderr, exit code 2 -----------------------
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+@pytest.mark.parametrize("text", ["", "(only a comment)\n; and another\n%\n", "G21 G90\nM30\n"])
+@pytest.mark.parametrize("command", [["estimate"], ["estimate", "--json"], ["simulate"]])
+def test_a_program_without_motion_is_an_error(tmp_path, capsys, text, command):
+    prog, png = tmp_path / "empty.nc", tmp_path / "f.png"
+    prog.write_text(text)
+    args = [command[0], str(prog), *command[1:]]
+    if command == ["simulate"]:
+        args += ["--plot", str(png)]
+    assert main(args) == 2
+    assert _one_line_error(capsys) == f"{prog}: no motion"
+    assert not png.exists()
+
+
+def test_a_dwell_alone_is_timed(tmp_path, capsys):
+    prog = tmp_path / "dwell.nc"
+    prog.write_text("G4 P1.5\n")
+    assert main(["estimate", str(prog), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["cycle_time_s"] == pytest.approx(1.5)
+
+
+def _stdin(monkeypatch, text: str) -> None:
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(text.encode())))
+
+
+def test_estimate_reads_standard_input(monkeypatch, capsys):
+    _stdin(monkeypatch, PROGRAM)
+    assert main(["estimate", "-", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["program"] == "<stdin>"
+    # 5 mm rapid at 500 mm/s + 35 mm at 10 mm/s (generic_mill, cam)
+    assert data["cycle_time_s"] == pytest.approx(5 / 500 + 3.5)
+
+
+def test_errors_on_standard_input_name_it(monkeypatch, capsys):
+    _stdin(monkeypatch, "G0 X0\nG1 X1\n")
+    assert main(["estimate", "-"]) == 2
+    assert _one_line_error(capsys) == "<stdin>:2: G1 with no feed rate set (F)"
+    _stdin(monkeypatch, "")
+    assert main(["simulate", "-"]) == 2
+    assert _one_line_error(capsys) == "<stdin>: no motion"
+
+
+def test_machine_file_with_missing_keys_names_them(program, tmp_path, capsys):
+    toml = tmp_path / "bad.toml"
+    toml.write_text('description = "half a machine"\nperiod_s = 0.001\nrapid_feed_mm_s = 500.0\n')
+    assert main(["estimate", str(program), "--machine", str(toml)]) == 2
+    line = _one_line_error(capsys)
+    assert line.startswith(f"nctwin: {toml}: missing field(s) ")
+    assert "axis_max_velocity_mm_s" in line and "max_feed_mm_s" in line
+    assert "rapid_feed_mm_s" not in line
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["estimate", "/no/such/file.nc"], "/no/such/file.nc: cannot read the file: "),
+        (["estimate", "{dir}"], "{dir}: is a directory, not a program"),
+        (["estimate", "{bin}"], "{bin}: binary data (NUL bytes), not a G-code program"),
+        (["estimate", "{prog}", "--machine", "nope"], "nctwin: machine = 'nope' is unknown"),
+        (["estimate", "{prog}", "--machine", "{badtoml}"], "nctwin: machine profile {badtoml}"),
+        (["estimate", "{prog}", "--method", "nope"], "nctwin: argument --method: invalid choice"),
+        (["estimate"], "nctwin: the following arguments are required: program"),
+        (["simulate", "{prog}", "--units", "furlong"], "nctwin: argument --units: invalid"),
+        (["simulate", "{prog}", "--plot", "{dir}/no/f.png"], "nctwin: {dir}/no/f.png: No such"),
+        (["estimate", "{prog}", "--method", "bilstm"], "nctwin: machine = 'generic_mill' has no"),
+    ],
+)
+def test_ordinary_mistakes_give_one_line_and_exit_2(program, tmp_path, capsys, args, expected):
+    binary = tmp_path / "part.bin"
+    binary.write_bytes(bytes(range(256)) * 4)
+    badtoml = tmp_path / "syntax.toml"
+    badtoml.write_text("description = \n")
+    names = {"{prog}": program, "{dir}": tmp_path, "{bin}": binary, "{badtoml}": badtoml}
+
+    def fill(s: str) -> str:
+        for key, value in names.items():
+            s = s.replace(key, str(value))
+        return s
+
+    assert main([fill(a) for a in args]) == 2
+    assert _one_line_error(capsys).startswith(fill(expected))
+
+
+@pytest.mark.parametrize("command", [[], ["estimate"], ["simulate"], ["machines"]])
+def test_help_is_plain_text_with_examples(capsys, command):
+    assert main([*command, "--help"]) == 0
+    out = capsys.readouterr().out
+    assert "``" not in out and ":func:" not in out and ":mod:" not in out
+    if command != ["machines"]:
+        assert "examples:" in out
+        assert "nctwin " + (command[0] if command else "estimate") + " part.nc" in out
+
+
+# --- progress: a bar on a terminal only --------------------------------------------------------
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_no_progress_output_in_a_pipe(program, capsys):
+    assert main(["estimate", str(program), "--method", "kernel"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_progress_bar_on_a_terminal_but_not_with_json(program, capsys, monkeypatch):
+    term = _Terminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    assert main(["simulate", str(program)]) == 0
+    assert "simulate (FIR kernel)" in term.getvalue()
+    assert "cycle time" in capsys.readouterr().out
+    term = _Terminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    assert main(["estimate", str(program), "--json"]) == 0
+    assert term.getvalue() == ""
+    json.loads(capsys.readouterr().out)
+
+
+# --- learned estimates never below the physical floor ------------------------------------------
+
+#: A 20 mm Z rapid (LinuxCNC sim: rapid 200 mm/s, Z at most 100 mm/s: 0.2 s), then a 100 mm
+#: square at 20 mm/s (F1200): 5 s a side. Floor: 0.2 + 4 x 5 = 20.2 s. Both networks predict
+#: the sides faster than 20 mm/s (about 18 s for the four).
+SQUARE = "G21 G90 G64 P0.1\nG0 Z-20\nG1 X100 F1200\nY100\nX0\nY0\nM2\n"
+
+
+def test_move_floors_by_hand():
+    from nctwin import parse
+    from nctwin.estimate.learned import _floored_estimate, move_data, move_floors_s
+    from nctwin.machine import load_machine
+
+    machine = load_machine("linuxcnc_sim")
+    tp = parse(SQUARE.replace("M2\n", "G4 P0.5\nM2\n"))
+    data = move_data("square", tp, machine)
+    assert move_floors_s(data) == pytest.approx([0.2, 5.0, 5.0, 5.0, 5.0])
+    # predictions: the rapid and one side above their floors, three sides below
+    est = _floored_estimate(tp, data, np.array([0.3, 6.0, 4.0, 1.0, 4.9]), "bilstm", machine)
+    assert est.clamped_moves == 3
+    assert est.block_times_s == pytest.approx([0.3, 6.0, 5.0, 5.0, 5.0, 0.5])
+    assert est.cycle_time_s == pytest.approx(21.8)
+    assert est.unclamped_time_s == pytest.approx(16.2 + 0.5)
+    assert est.floor_time_s == pytest.approx(20.7)
+    summary = est.summary()
+    assert summary["clamped_to_floor"] == 3 and summary["floor_time_s"] == pytest.approx(20.7)
+
+
+@pytest.mark.parametrize("method", ["bilstm", "axis_nn"])
+def test_learned_estimates_are_raised_to_the_floor(tmp_path, capsys, method):
+    prog = tmp_path / "square.nc"
+    prog.write_text(SQUARE)
+    args = ["estimate", str(prog), "--machine", "linuxcnc_sim", "--method", method]
+    assert main([*args, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["floor_time_s"] == pytest.approx(20.2)
+    assert data["cycle_time_s"] >= 20.2 - 1e-9
+    assert data["by_kind"]["linear"]["time_s"] >= 20.0 - 1e-9
+    # the networks predict the sides too fast: each raised to 5 s exactly
+    assert data["clamped_to_floor"] >= 4
+    assert data["by_kind"]["linear"]["time_s"] == pytest.approx(20.0)
+    assert data["unclamped_cycle_time_s"] < 20.0
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    n = data["clamped_to_floor"]
+    assert f"{n} moves raised to the physical floor (length / feed)" in out
+
+
+def test_other_methods_report_no_floor(program, capsys):
+    assert main(["estimate", str(program), "--json", "--method", "block_overlap"]) == 0
+    assert "clamped_to_floor" not in json.loads(capsys.readouterr().out)
+
+
+# --- the feed plot -----------------------------------------------------------------------------
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures ``nctwin simulate --plot`` draws, kept for inspection."""
+    from nctwin.report import plots
+
+    drawn = []
+    draw = plots.feed_figure
+
+    def keep(plot):
+        fig = draw(plot)
+        drawn.append(fig)
+        return fig
+
+    monkeypatch.setattr(plots, "feed_figure", keep)
+    return drawn
+
+
+def _feed_axis_top(fig) -> float:
+    return fig.axes[0].get_ylim()[1]
+
+
+def test_feed_plot_scales_to_the_cutting_feed(program, tmp_path, capsys, figures):
+    png = tmp_path / "feed.png"
+    assert main(["simulate", str(program), "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    fig = figures[0]
+    time_ax, xy_ax, colour_bar = fig.axes
+    # F600 is the only cutting feed (mm/min in a G21 program)
+    assert _feed_axis_top(fig) == pytest.approx(1.1 * 600)
+    assert time_ax.get_ylabel() == "feed (mm/min)" and colour_bar.get_ylabel() == "feed (mm/min)"
+    assert xy_ax.get_xlabel() == "X (mm)"
+
+
+def test_feed_plot_with_a_long_rapid_clips_it(tmp_path, capsys, figures):
+    prog, png = tmp_path / "rapid.nc", tmp_path / "feed.png"
+    # a 500 mm rapid (generic_mill: 30000 mm/min), then 30 mm at F1200
+    prog.write_text("G21 G90\nG0 X500 Y0 Z5\nG1 Z0 F600\nG1 X530 F1200\nM30\n")
+    assert main(["simulate", str(prog), "--plot", str(png)]) == 0
+    assert png.stat().st_size > 10_000
+    fig = figures[0]
+    assert _feed_axis_top(fig) <= 1.2 * 1200
+    time_ax, xy_ax = fig.axes[:2]
+    labels = [line.get_label() for line in time_ax.get_lines()]
+    assert "rapid, clipped (rapid feed 30000 mm/min)" in labels
+    rapid_xy = [line for line in xy_ax.get_lines() if line.get_label() == "rapid"]
+    assert rapid_xy[0].get_linestyle() == "--"
+    # the rapid's end is in the XY panel: X from 0 to 500
+    assert np.nanmax(rapid_xy[0].get_xdata()) == pytest.approx(500.0)
+
+
+@pytest.mark.parametrize(
+    ("units_args", "ylabel", "top"),
+    [([], "feed (in/min)", 1.1 * 20.0), (["--units", "mm/s"], "feed (mm/s)", 1.1 * 20 * 25.4 / 60)],
+)
+def test_feed_plot_units(tmp_path, capsys, figures, units_args, ylabel, top):
+    prog = tmp_path / "inch.nc"
+    prog.write_text("(an inch program)\nG20 G90\nG1 X2 F20\nY1\nM30\n")
+    assert main(["simulate", str(prog), "--plot", str(tmp_path / "f.png"), *units_args]) == 0
+    assert figures[0].axes[0].get_ylabel() == ylabel
+    assert _feed_axis_top(figures[0]) == pytest.approx(top)
+    assert figures[0].axes[1].get_xlabel() == ("X (in)" if not units_args else "X (mm)")
+
+
+def test_program_units_reads_the_first_g20_or_g21_outside_comments():
+    from nctwin.cli import program_units
+
+    assert program_units("(G20 in a comment)\nG21 G90\n") == "mm"
+    assert program_units("N10G20\nG1 X1 F10\n") == "inch"
+    assert program_units("G1 X1 F10 ; G20\n", default="inch") == "inch"
+    assert program_units("G1 X1 F10 G201\n") == "mm"
+
+
+def test_the_command_line_does_not_import_torch_unless_a_network_runs():
+    # torch takes seconds to import: only bilstm and axis_nn need it
+    code = "import sys, nctwin.cli; print('torch' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

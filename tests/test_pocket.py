@@ -127,3 +127,47 @@ def test_no_gouge_and_the_whole_floor_is_cut(path):
 def test_bad_parameters_named(kwargs, name):
     with pytest.raises(ValueError, match=name):
         pocket_program(**kwargs)
+
+
+def test_paper_pockets_have_the_published_statistics():
+    from nctwin.programs.pocket import PAPER_POCKETS, paper_pocket_rings, pocket_stats
+
+    t2 = pocket_stats(np.vstack(paper_pocket_rings("table2")))
+    # Table 2: about 5000 G-lines; CAM 125-174 s at 75-92 mm/s -> 11.5-13.1 m
+    assert abs(t2["lines"] - 5000) <= 50
+    assert 11.5 <= t2["path_m"] <= 13.1
+    # Table 3: CAM 55-63 s at 70-80 mm/s -> about 4.4 m (offsets come in steps: within 5 %)
+    t3 = pocket_stats(np.vstack(paper_pocket_rings("table3")))
+    assert abs(t3["path_m"] - 4.4) / 4.4 < 0.05
+    assert PAPER_POCKETS["table3"].chord_tol_mm == PAPER_POCKETS["table2"].chord_tol_mm
+
+
+def test_corner_zones_are_short_chords_on_the_corner_radius():
+    sharp = np.vstack(pocket_rings())
+    rounded = np.vstack(pocket_rings(corner_radius_mm=0.8))
+    assert len(rounded) > len(sharp)  # the sharp corners became chords
+    # a 90-degree corner rounded with r: the path passes r (sqrt 2 - 1) inside the vertex
+    corner = np.array([230.0 - TOOL_R, TOOL_R])  # the outermost ring's bottom-right corner
+    d = np.linalg.norm(rounded - corner, axis=1).min()
+    assert d == pytest.approx(0.8 * (math.sqrt(2) - 1), abs=0.01)
+    assert np.linalg.norm(sharp - corner, axis=1).min() < 1e-9
+
+
+def test_pocket_stats_by_hand():
+    from nctwin.programs.pocket import pocket_stats
+
+    s = pocket_stats(np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 4.5], [3.0, 4.5], [3.0, 4.0]]))
+    assert s["lines"] == 3  # the repeated point is no G-line
+    assert s["path_m"] == pytest.approx(6.0e-3)
+    assert s["short_share_pct"] == pytest.approx(200 / 3)
+    assert s["short_length_pct"] == pytest.approx(100 * 1.0 / 6.0)
+    assert s["seg_max_mm"] == 5.0
+
+
+def test_paper_pocket_bad_name_named():
+    from nctwin.programs.pocket import paper_pocket_program
+
+    with pytest.raises(ValueError, match="name"):
+        paper_pocket_program("table9", feed_mm_s=70.0)
+    with pytest.raises(ValueError, match="feed_mm_s"):
+        paper_pocket_program("table2", feed_mm_s=-1.0)

@@ -7,7 +7,6 @@ import json
 import pandas as pd
 import pytest
 
-from nctwin.chapters import lee2022
 from nctwin.report.claims import format_claim, report_claims
 from nctwin.report.tables import Claim, format_table, write_claims
 
@@ -58,28 +57,3 @@ def test_duplicate_ids_write_and_print_nothing(tmp_path, capsys):
         report_claims("nb", [CLAIMS[0], CLAIMS[0]], results_dir=tmp_path)
     assert capsys.readouterr().out == ""
     assert not (tmp_path / "nb" / "claims.json").exists()
-
-
-def test_lee_claims_from_the_accuracy_table():
-    rows = []
-    for prog, acc in (("iso10791_7_test_piece", 99.9), ("other", 99.5)):
-        for s in (1, 2):
-            for variant, a in (("full", acc), ("no_overlap", acc - 4), ("no_inposition", acc - 1)):
-                rows.append({"program": prog, "param_set": s, "variant": variant,
-                             "measured_s": 2000.0, "accuracy_pct": a})  # fmt: skip
-    claims = lee2022.claims(pd.DataFrame(rows))
-    assert [c.id for c in claims] == [
-        "accuracy_iso10791_7_test_piece_set1",
-        "overlap_matters_iso10791_7_test_piece_set1",
-        "inposition_helps_iso10791_7_test_piece_set1",
-        "accuracy_iso10791_7_test_piece_set2",
-        "overlap_matters_iso10791_7_test_piece_set2",
-        "inposition_helps_iso10791_7_test_piece_set2",
-        "accuracy_other_set1",
-        "overlap_matters_other_set1",
-        "accuracy_other_set2",
-        "overlap_matters_other_set2",
-        "test_piece_over_30_min",
-    ]
-    assert all(c.holds for c in claims)
-    assert claims[-1].value == pytest.approx(2000.0 / 60)

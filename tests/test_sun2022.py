@@ -58,14 +58,63 @@ class _Constant:
         return np.full((len(x), 1), self.value)
 
 
-def test_eq9_eq10_by_hand():
-    from nctwin.chapters.sun2022 import oracle_time, predict_time, run_pocket
+@pytest.fixture(scope="module")
+def triangle_run():
+    from nctwin.chapters.sun2022 import run_pocket
     from nctwin.machine import load_machine
 
-    run = run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_machine("sun2022_siemens"))
+    return run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_machine("sun2022_siemens"))
+
+
+def test_eq9_eq10_by_hand(triangle_run):
+    from nctwin.chapters.sun2022 import predict_time, target_time
+
+    run = triangle_run
     # axis feeds (3, 4, 0) give a resultant of 5 mm/s (eq. 9): 70 mm take 14 s (eq. 10)
-    t, resultant = predict_time([_Constant(3.0), _Constant(4.0), _Constant(0.0)], run)
+    t, resultant = predict_time([[_Constant(3.0), _Constant(4.0), _Constant(0.0)]], run)
     np.testing.assert_allclose(resultant, 5.0)
     assert t == pytest.approx(70.0 / 5.0)
     # block averages over a long, simple path: eq. 10 gives the machine's time back closely
-    assert oracle_time(run, "true") == pytest.approx(run.measured_s, rel=0.01)
+    assert target_time(run, "true") == pytest.approx(run.measured_s, rel=0.01)
+
+
+def test_the_ensemble_averages_the_seeds_feeds(triangle_run):
+    from nctwin.chapters.sun2022 import predict_time
+
+    # seeds predicting (2, 4, 0) and (4, 4, 0) average to (3, 4, 0): 5 mm/s, 14 s, not the
+    # mean of the seeds' times (70 / sqrt(20) and 70 / sqrt(32))
+    a = [_Constant(2.0), _Constant(4.0), _Constant(0.0)]
+    b = [_Constant(4.0), _Constant(4.0), _Constant(0.0)]
+    assert predict_time([a, b], triangle_run)[0] == pytest.approx(14.0)
+
+
+def test_models_are_table2():
+    from nctwin.chapters.sun2022 import MODELS
+    from nctwin.report.tables import load_paper_table
+
+    table2 = load_paper_table("sun2022_table2")
+    paper = {
+        f"model #{m}": tuple(int(p) for p in str(pockets).split(";"))
+        for m, pockets in zip(table2["model"], table2["train_pockets"], strict=True)
+    }
+    assert paper == MODELS
+    assert (table2["validation_pocket"] == 4).all() and (table2["test_pocket"] == 4).all()
+
+
+def test_claims_by_hand():
+    import pandas as pd
+
+    from nctwin.chapters.sun2022 import claims
+
+    pockets = range(1, 9)
+    m1 = [0.65, 6.41, 5.61, 1.46, 4.21, 6.42, 7.50, 9.15]  # the paper's Table 3
+    m2 = [1.95, 1.28, 0.0, 2.93, 0.93, 2.75, 1.25, 2.61]  # and Table 4
+    sources = pd.DataFrame({"pocket": pockets, "m1_5hz_err_pct": m1, "m2_5hz_err_pct": m2,
+                            "m1_1khz_err_pct": m1, "m2_1khz_err_pct": m2})  # fmt: skip
+    table3 = pd.DataFrame({"cam_s": [90.0] * 8, "measured_s": [100.0] * 8})
+    result = {c.id: c for c in claims(sources, table3)}
+    # the paper's own numbers pass every claim it makes
+    assert all(c.holds for c in result.values())
+    assert result["model2_improves_2_3_5_6_7_8_5hz"].value == pytest.approx(0.93 - 4.21)  # pocket 5
+    sources.loc[0, "m2_5hz_err_pct"] = -3.1
+    assert not {c.id: c for c in claims(sources, table3)}["model2_below_3pct_5hz"].holds

@@ -73,3 +73,54 @@ def test_features_rows_match_the_program():
     np.testing.assert_allclose(x[:, 2], [np.pi, np.pi / 2, np.pi / 2])
     np.testing.assert_allclose(x[:, 3], [np.pi / 2, np.pi / 2, np.pi])
     np.testing.assert_allclose(x[:, 4], 0.2)
+
+
+def test_cam_blend_program_seeded_and_in_range():
+    from nctwin.programs.camblend import LINE_MM, cam_blend_program
+
+    a = cam_blend_program(5, n_lines=4000, feed_mm_s=70.0, tol_mm=0.075)
+    assert a == cam_blend_program(5, n_lines=4000, feed_mm_s=70.0, tol_mm=0.075)
+    assert a != cam_blend_program(6, n_lines=4000, feed_mm_s=70.0, tol_mm=0.075)
+    tp = gcode.parse(a)
+    assert 3900 <= len(tp) <= 4000  # points that round onto their predecessor are dropped
+    assert tp.lengths_mm.max() <= LINE_MM[1] + 1e-3
+    np.testing.assert_allclose(tp.effective_tolerance_mm(1.0), 0.075)
+    x = chien2023_features(tp, 1.0)
+    long = x[:, 1] > 10.0
+    # lines leave and meet arcs tangentially (the turn onto a chord is half the chord's angle)
+    tangent_both = long & (x[:, 2] < 0.1) & (x[:, 3] < 0.1)
+    assert tangent_both.sum() >= 5
+    assert (x[:, 1] < 1.0).mean() > 0.4  # the arcs' chords
+    assert (x[:, 2] > np.radians(149)).sum() >= 5  # reversals
+
+
+def test_cam_blend_arc_chords_within_the_chord_tolerance():
+    from nctwin.programs.camblend import CHORD_TOL_MM, RADIUS_MM, _arc
+
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        turn = rng.uniform(-np.pi, np.pi)
+        lengths, turns, rest = _arc(rng, turn)
+        assert turns.sum() + rest == pytest.approx(turn)  # the arc turns the path by `turn`
+        phi = abs(turns[1]) if len(turns) > 1 else 2 * abs(turns[0])
+        radius = lengths[0] / (2 * np.sin(phi / 2))  # all chords of one circle
+        np.testing.assert_allclose(lengths, lengths[0])
+        assert RADIUS_MM[0] - 1e-9 <= radius <= RADIUS_MM[1] + 1e-9
+        sagitta = radius * (1 - np.cos(phi / 2))
+        assert sagitta <= max(CHORD_TOL_MM[1], radius * (1 - np.cos(abs(turn) / 300))) + 1e-12
+
+
+def test_cam_blend_specs_shares_and_ranges():
+    from nctwin.programs.camblend import cam_blend_specs
+
+    specs = cam_blend_specs(1, n_programs=30, n_lines=2000, feed_range_mm_s=(60, 80),
+                            tol_range_mm=(0.05, 0.1),
+                            shares={"global": 0.1, "mixed": 1 / 30, "cam": 26 / 30})  # fmt: skip
+    assert [s.family for s in specs].count("global") == 3
+    assert [s.family for s in specs].count("mixed") == 1
+    assert [s.family for s in specs].count("cam") == 26
+    assert all(60 <= s.feed_mm_s <= 80 and 0.05 <= s.tol_mm <= 0.1 for s in specs)
+    assert len({s.seed for s in specs}) == 30
+    with pytest.raises(ValueError, match="shares"):
+        cam_blend_specs(1, n_programs=3, n_lines=10, feed_range_mm_s=(60, 80),
+                        tol_range_mm=(0.05, 0.1), shares={"cam": 0.5})  # fmt: skip

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import torch
 
@@ -48,12 +49,38 @@ def test_histogram_uses_the_papers_bins_and_counts_beyond_the_last() -> None:
 
 def test_transfer_metrics_by_hand() -> None:
     m = zh.transfer_metrics(np.array([1.0, 2.5, 3.0, 0.2]), np.array([1.5, 2.0, 1.0, 0.2]))
-    assert m == {"max_abs_err_um": 2.0, "share_below_1um_pct": 75.0, "mean_abs_err_um": 0.75}
+    # errors 0.5, 0.5, 2.0, 0.0: below 1 um 3 of 4, below 0.5 um (strictly) 1 of 4
+    assert m == {"max_abs_err_um": 2.0, "share_below_1um_pct": 75.0,
+                 "share_below_0p5um_pct": 25.0, "mean_abs_err_um": 0.75}  # fmt: skip
 
 
 def test_variant_rejects_bad_epochs() -> None:
     with pytest.raises(ValueError, match="epochs"):
         zh.variant_configs(325, epochs=0)
+
+
+def test_paper_configs_batches() -> None:
+    model, full = zh.paper_configs(325)
+    assert model.dropout == 0.5 and model.weight_init == "normal"
+    assert full.learning_rate == 1e-5 and full.momentum == 0.8 and full.max_epochs == 2000
+    assert full.patience == full.max_epochs  # no early stop: the paper's 2000 epochs
+    _, one = zh.paper_configs(325, batch_rows=1, dropout=0.0, epochs=1)
+    assert (one.window_lines, one.batch_size, one.max_epochs) == (1, 1, 1)
+    with pytest.raises(ValueError, match="batch_rows"):
+        zh.paper_configs(325, batch_rows=0)
+
+
+def test_dropout_conventions_read_keep_p_as_drop_one_minus_p() -> None:
+    paper = load_paper_table("zhang2023_table2")
+    drops = np.round(np.arange(0.1, 1.0, 0.1), 1)
+    # a sweep whose test MSE is the drop probability itself, so each row can be checked by eye
+    sweep = pd.DataFrame({"dropout_p": drops, "final_train_mse": drops, "test_mse": drops,
+                          "share_below_1um_pct": 100 - drops})  # fmt: skip
+    table = zh.dropout_conventions(sweep, paper).set_index("paper_p")
+    np.testing.assert_allclose(table.loc[0.3, ["keep_test_mse", "drop_test_mse"]], [0.7, 0.3])
+    np.testing.assert_allclose(table.loc[0.5, ["keep_test_mse", "drop_test_mse"]], [0.5, 0.5])
+    assert table.loc[0.9, "keep_drop_prob"] == pytest.approx(0.1)
+    assert table.loc[0.4, "paper_mse"] == 0.009
 
 
 def _network(x: np.ndarray, y: np.ndarray) -> Trained:

@@ -1,36 +1,159 @@
-"""The ``nctwin`` command line.
+"""The ``nctwin`` command line: ``estimate``, ``simulate`` and ``machines``.
 
-``nctwin estimate PROGRAM [--machine NAME]
-[--method cam|kernel|block_overlap|planner|bilstm|axis_nn] [--json]`` prints the cycle time of
-a part program (by default with :func:`nctwin.estimate.default_method`); ``nctwin simulate
-PROGRAM [--machine NAME] [--plot feed.png] [--csv motion.csv] [--json]`` interpolates it on the
-FIR kernel; ``nctwin machines`` lists the shipped machine profiles. Bad input ends with exit
-code 2 and one line ``file:line: reason`` on standard error, never a traceback.
+``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with
+:func:`nctwin.estimate.default_method`); ``nctwin simulate PROGRAM`` interpolates it on the FIR
+kernel and can write the feed plot and the sampled motion; ``nctwin machines`` lists the shipped
+machine profiles. ``-`` reads the program from standard input. Bad input ends with exit code 2
+and one line on standard error, never a traceback: ``file:line: reason`` for a line of the
+program that cannot be read (one such line per error the reader lists), ``file: reason`` for a
+file that is not a program (absent, a directory, binary, no motion), ``nctwin: reason`` for the
+rest (a bad machine profile or argument, an output file that cannot be written).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import re
 import sys
 from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
 
 from . import __version__
 from .estimate import METHODS, default_method, estimate
 from .estimate.kernel import fir_settings
-from .gcode import GCodeError, parse_file
+from .gcode import GCodeError, parse
 from .kernel import fir
-from .machine import DEFAULT_MACHINE, available_machines, load_machine
+from .machine import DEFAULT_MACHINE, MachineProfile, available_machines, load_machine
+from .motion import Motion
+from .toolpath import MotionKind, Toolpath
 
-__all__ = ["main"]
+__all__ = ["FEED_UNITS", "InputError", "main", "program_units"]
+
+DESCRIPTION = """\
+Cycle time and motion of a part program (G-code) on a virtual machine tool:
+estimated by one of several methods (analytic, simulated, learned), or simulated
+on the FIR kernel with a plot of the feed.
+
+A program is a file, or - for standard input. Bad input ends with exit code 2 and
+one line on standard error: file:line: reason for a line of the program that
+cannot be read, file: reason for a file that is not a program, nctwin: reason
+for the rest."""
+
+EXAMPLES = """\
+examples:
+  nctwin estimate part.nc                          cycle time on the default machine
+  nctwin estimate part.nc --method kernel          simulated on the FIR kernel
+  nctwin estimate part.nc --machine fanuc_0i_testbed --method block_overlap --json
+  nctwin estimate part.nc --machine linuxcnc_sim   LinuxCNC: its chapter's best method
+  cat part.nc | nctwin estimate -                  the program from standard input
+  nctwin simulate part.nc --plot feed.png --csv motion.csv
+  nctwin machines"""
+
+ESTIMATE_EXAMPLES = """\
+methods:
+  cam            programmed feeds, no acceleration (what a CAM system prints)
+  kernel         simulated on the FIR kernel, times between junction points
+  block_overlap  Lee et al. 2022: acc/dec time constants and block overlap
+  planner        a LinuxCNC-like look-ahead planner with blend arcs
+  bilstm         Chien et al. 2023's BiLSTM, trained on LinuxCNC's recordings
+  axis_nn        Sun et al. 2022's per-axis networks, trained on LinuxCNC's recordings
+bilstm and axis_nn exist for linuxcnc_sim only; they never predict a move faster than its
+length over its feed within the machine's limits (the physical floor), and say how many
+moves they raised to it.
+
+examples:
+  nctwin estimate part.nc
+  nctwin estimate part.nc --method kernel --json
+  nctwin estimate part.nc --machine linuxcnc_sim --method bilstm
+  nctwin estimate part.nc --machine own_machine.toml
+  cat part.nc | nctwin estimate -"""
+
+SIMULATE_EXAMPLES = """\
+The plot has two panels: the feed over time, scaled to the cutting moves (rapids
+clipped), and the tool path in XY coloured by the simulated feed. Feeds are in the
+program's units (mm/min after G21, in/min after G20) unless --units says otherwise.
+
+examples:
+  nctwin simulate part.nc
+  nctwin simulate part.nc --plot feed.png
+  nctwin simulate part.nc --plot feed.png --units mm/s --csv motion.csv
+  nctwin simulate part.nc --machine paper1_sim --json"""
+
+#: Feed units of ``nctwin simulate --units``: factor from mm/s, length unit, factor from mm.
+FEED_UNITS = {
+    "mm/min": (60.0, "mm", 1.0),
+    "in/min": (60.0 / 25.4, "in", 1.0 / 25.4),
+    "mm/s": (1.0, "mm", 1.0),
+}
+
+#: Most samples a plot draws (longer motions are thinned evenly).
+PLOT_MAX_SAMPLES = 50_000
+
+#: Feed axis of the plot: this much above the highest cutting feed.
+PLOT_HEADROOM = 1.1
+
+_UNITS_WORD = re.compile(r"(?<![A-Z])G0*2([01])(?![0-9.])", re.IGNORECASE)
+_COMMENT = re.compile(r"\([^)\n]*\)|;[^\n]*")
+
+
+class InputError(ValueError):
+    """A program file that is not a program: absent, a directory, binary, or without motion.
+
+    Its message starts with the file's name.
+    """
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line, ``nctwin: reason (see nctwin ... --help)``, exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"nctwin: {message} (see {self.prog} --help)\n")
+
+
+class _Stages:
+    """A progress bar over named stages on standard error, only where it is a terminal."""
+
+    def __init__(self, stages: Sequence[str], enabled: bool) -> None:
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=len(stages), file=sys.stderr, leave=False, bar_format=(
+                "{desc:<28} {bar} {n_fmt}/{total_fmt} [{elapsed}]"))  # fmt: skip
+        self.started = False
+
+    def __call__(self, stage: str) -> None:
+        """Begin ``stage`` (the previous one is done)."""
+        if self.bar is None:
+            return
+        self.bar.set_description_str(stage, refresh=False)
+        if self.started:
+            self.bar.update(1)
+        self.started = True
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="nctwin", description=__doc__.split("\n\n")[0])
+    fmt = argparse.RawDescriptionHelpFormatter
+    p = _Parser(prog="nctwin", description=DESCRIPTION, epilog=EXAMPLES, formatter_class=fmt)
     p.add_argument("--version", action="version", version=f"nctwin {__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
+    sub = p.add_subparsers(title="commands", dest="command", required=True, metavar="COMMAND")
 
-    e = sub.add_parser("estimate", help="estimate the cycle time of a part program")
+    e = sub.add_parser(
+        "estimate",
+        help="estimate the cycle time of a part program",
+        description="Estimate the cycle time of a part program.",
+        epilog=ESTIMATE_EXAMPLES,
+        formatter_class=fmt,
+    )
     _program_args(e)
     e.add_argument(
         "--method",
@@ -41,25 +164,44 @@ def _parser() -> argparse.ArgumentParser:
     )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
-    m = sub.add_parser("simulate", help="interpolate a part program on the FIR kernel")
+    m = sub.add_parser(
+        "simulate",
+        help="interpolate a part program on the FIR kernel",
+        description="Interpolate a part program on the FIR kernel: cycle time, samples,\n"
+        "the feed plot and the sampled motion.",
+        epilog=SIMULATE_EXAMPLES,
+        formatter_class=fmt,
+    )
     _program_args(m)
-    m.add_argument("--plot", metavar="PNG", help="write commanded vs actual feed over time")
+    m.add_argument("--plot", metavar="PNG", help="write the feed over time and over the path")
     m.add_argument("--csv", metavar="CSV", help="write the sampled motion")
+    m.add_argument(
+        "--units",
+        choices=tuple(FEED_UNITS),
+        default=None,
+        help="feed units of the plot and the output (default: the program's, mm/min or in/min)",
+    )
     m.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
-    sub.add_parser("machines", help="list the shipped machine profiles")
+    sub.add_parser(
+        "machines",
+        help="list the shipped machine profiles",
+        description="List the shipped machine profiles (names for --machine).",
+        formatter_class=fmt,
+    )
     return p
 
 
 def _program_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("program", help="G-code file")
+    p.add_argument("program", help="G-code file, or - for standard input")
     p.add_argument(
         "--machine",
         default=DEFAULT_MACHINE,
-        help=f"shipped profile name or .toml path (default: {DEFAULT_MACHINE})",
+        help=f"shipped profile name (see nctwin machines) or .toml path (default: "
+        f"{DEFAULT_MACHINE})",
     )
     p.add_argument(
-        "--units",
+        "--input-units",
         default="mm",
         choices=("mm", "inch"),
         help="units before the program's own G20/G21 (default: mm)",
@@ -78,11 +220,62 @@ def _format_duration(seconds: float) -> str:
     return f"{h}:{m:02d}:{s:04.1f}"
 
 
-def _load(args: argparse.Namespace):
-    """The machine and the parsed program named on the command line."""
+def _read_program(name: str) -> tuple[str, str]:
+    """The text of the program named on the command line and its name for messages.
+
+    ``-`` is standard input (``<stdin>``). Text is UTF-8, or Latin-1 where it is not.
+
+    Raises
+    ------
+    InputError
+        If the file cannot be read, is a directory or holds binary data (NUL bytes).
+    """
+    if name == "-":
+        source = "<stdin>"
+        stream = getattr(sys.stdin, "buffer", None)
+        data = stream.read() if stream is not None else sys.stdin.read().encode()
+    else:
+        source, p = name, Path(name)
+        if p.is_dir():
+            raise InputError(f"{source}: is a directory, not a program")
+        try:
+            data = p.read_bytes()
+        except OSError as exc:
+            raise InputError(f"{source}: cannot read the file: {exc.strerror or exc}") from None
+    if b"\0" in data:
+        raise InputError(f"{source}: binary data (NUL bytes), not a G-code program")
+    try:
+        return data.decode("utf-8"), source
+    except UnicodeDecodeError:
+        return data.decode("latin-1"), source
+
+
+def program_units(text: str, default: str = "mm") -> str:
+    """``"inch"`` or ``"mm"``: the first G20 or G21 of the program outside comments, else
+    ``default`` (a program that changes units is labelled by its first)."""
+    match = _UNITS_WORD.search(_COMMENT.sub(" ", text))
+    if match is None:
+        return default
+    return "inch" if match.group(1) == "0" else "mm"
+
+
+def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Toolpath, str]:
+    """The machine, the parsed program and its text.
+
+    Raises
+    ------
+    InputError
+        If the program has no motion (no move of non-zero length and no dwell).
+    """
+    stage("machine")
     machine = load_machine(args.machine)
-    tp = parse_file(args.program, units=args.units, dwell_p_unit=args.dwell_p_unit)
-    return machine, tp
+    stage("read")
+    text, source = _read_program(args.program)
+    stage("parse")
+    tp = parse(text, source=source, units=args.input_units, dwell_p_unit=args.dwell_p_unit)
+    if not ((tp.lengths_mm > 0).any() or (tp.dwell_s > 0).any()):
+        raise InputError(f"{source}: no motion")
+    return machine, tp, text
 
 
 def _report(summary: dict, rows: list[tuple[str, str]], extra: list[str], as_json: bool) -> int:
@@ -108,77 +301,183 @@ def _common_rows(summary: dict, machine_note: str = "") -> list[tuple[str, str]]
     ]
 
 
-def _estimate(args: argparse.Namespace) -> int:
-    machine, tp = _load(args)
-    result = estimate(tp, machine, args.method or default_method(machine))
-    summary = {"program": args.program, **result.summary()}
+def _program_name(args: argparse.Namespace) -> str:
+    return "<stdin>" if args.program == "-" else args.program
+
+
+def _estimate(args: argparse.Namespace, enabled: bool) -> int:
+    method = args.method
+    stage = _Stages(["machine", "read", "parse", "estimate"], enabled)
+    try:
+        machine, tp, _ = _load(args, stage)
+        method = method or default_method(machine)
+        learned = method in ("bilstm", "axis_nn")
+        stage(f"estimate: {method}" + (" (trains on first use)" if learned else ""))
+        result = estimate(tp, machine, method)
+    finally:
+        stage.close()
+    summary = {"program": _program_name(args), **result.summary()}
     rows = _common_rows(summary)
     rows.insert(2, ("method", result.method))
+    if result.floor_time_s is not None:
+        rows.insert(4, ("floor", f"{result.floor_time_s:.3f} s  (every move at its feed)"))
     table = [f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}"] + [
         f"  {kind:<8} {r['blocks']:>8d} {r['length_mm']:>12.3f} {r['time_s']:>10.3f}"
         for kind, r in summary["by_kind"].items()
         if r["blocks"]
     ]
+    if result.clamped_moves:
+        n = result.clamped_moves
+        table.append(
+            f"\n{n} move{'s' if n != 1 else ''} raised to the physical floor (length / feed): "
+            f"{result.unclamped_time_s:.3f} s predicted before"
+        )
     return _report(summary, rows, table, args.json)
 
 
-def _simulate(args: argparse.Namespace) -> int:
-    machine, tp = _load(args)
-    motion = fir.run(tp, machine, fir_settings(machine))
-    summary = {
-        "program": args.program,
-        "machine": machine.name,
-        "kernel": "fir",
-        "cycle_time_s": motion.cycle_time_s,
-        "length_mm": tp.length_mm,
-        "blocks": len(tp),
-        "samples": len(motion),
-        "period_s": motion.period_s,
-        "max_speed_mm_s": float(motion.speed_mm_s.max(initial=0.0)),
-    }
-    if args.csv:
-        motion.to_frame().to_csv(args.csv, index=False, float_format="%.6f")
-        summary["csv"] = args.csv
-    if args.plot:
-        import matplotlib
+def _feed_plot(motion: Motion, tp: Toolpath, machine: MachineProfile, feed_unit: str, title: str):
+    """The :class:`~nctwin.report.plots.FeedPlot` of a simulated program, in ``feed_unit``
+    (a key of :data:`FEED_UNITS`), thinned to at most :data:`PLOT_MAX_SAMPLES` samples."""
+    from .report.plots import FeedPlot
 
-        matplotlib.use("Agg")
-        from .report.plots import feed_profile
+    per_mm_s, length_unit, per_mm = FEED_UNITS[feed_unit]
+    step = max(1, math.ceil(len(motion) / PLOT_MAX_SAMPLES))
+    idx = np.arange(0, len(motion), step)
+    if idx[-1] != len(motion) - 1:
+        idx = np.append(idx, len(motion) - 1)
+    block = motion.block[idx]
+    kind = tp.kind[block]
+    rapid = kind == MotionKind.RAPID
+    commanded = np.minimum(tp.feed_mm_s[block], machine.max_feed_mm_s)
+    commanded = np.where(kind == MotionKind.DWELL, np.nan, commanded)
+    actual = motion.speed_mm_s[idx]
+    cutting = (tp.kind != MotionKind.RAPID) & (tp.kind != MotionKind.DWELL)
+    cutting_feeds = np.minimum(tp.feed_mm_s[cutting], machine.max_feed_mm_s)
+    if len(cutting_feeds):
+        top_mm_s = float(cutting_feeds.max())
+    else:  # only rapids (and dwells): scale to them
+        top_mm_s = float(actual.max(initial=0.0)) or machine.rapid_feed_mm_s
+    xy_len = np.hypot(*(tp.end_mm[:, :2] - tp.start_mm[:, :2]).T)
+    moves = (tp.kind == MotionKind.RAPID) & (xy_len > 0)  # what shows in XY
+    rapid_xy = np.stack([tp.start_mm[moves, :2], tp.end_mm[moves, :2]], axis=1) * per_mm
+    return FeedPlot(
+        t_s=motion.t_s[idx],
+        commanded=commanded * per_mm_s,
+        actual=actual * per_mm_s,
+        rapid=rapid,
+        xy=motion.pos_mm[idx, :2] * per_mm,
+        rapid_xy=rapid_xy,
+        feed_top=PLOT_HEADROOM * top_mm_s * per_mm_s,
+        rapid_feed=machine.rapid_feed_mm_s * per_mm_s,
+        feed_unit=feed_unit,
+        length_unit=length_unit,
+        title=title,
+    )
 
-        ax = feed_profile(motion, tp, machine, title=f"{args.program} on {machine.name}")
-        ax.figure.savefig(args.plot, dpi=120)
-        summary["plot"] = args.plot
+
+def _simulate(args: argparse.Namespace, enabled: bool) -> int:
+    stages = ["machine", "read", "parse", "simulate (FIR kernel)"]
+    stages += ["plot"] * bool(args.plot) + ["csv"] * bool(args.csv)
+    stage = _Stages(stages, enabled)
+    try:
+        machine, tp, text = _load(args, stage)
+        stage("simulate (FIR kernel)")
+        motion = fir.run(tp, machine, fir_settings(machine))
+        feed_unit = args.units or (
+            "in/min" if program_units(text, args.input_units) == "inch" else "mm/min"
+        )
+        summary = {
+            "program": _program_name(args),
+            "machine": machine.name,
+            "kernel": "fir",
+            "cycle_time_s": motion.cycle_time_s,
+            "length_mm": tp.length_mm,
+            "blocks": len(tp),
+            "samples": len(motion),
+            "period_s": motion.period_s,
+            "max_speed_mm_s": float(motion.speed_mm_s.max(initial=0.0)),
+        }
+        if args.plot:
+            stage("plot")
+            import matplotlib
+
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+
+            from .report import plots
+
+            title = f"{_program_name(args)} on {machine.name} (FIR kernel)"
+            fig = plots.feed_figure(_feed_plot(motion, tp, machine, feed_unit, title))
+            try:
+                fig.savefig(args.plot, dpi=120)
+            finally:
+                plt.close(fig)
+            summary["plot"] = args.plot
+        if args.csv:
+            stage("csv")
+            motion.to_frame().to_csv(args.csv, index=False, float_format="%.6f")
+            summary["csv"] = args.csv
+    finally:
+        stage.close()
+    per_mm_s = FEED_UNITS[feed_unit][0]
     rows = _common_rows(summary, " (FIR kernel)")
     rows.append(("samples", f"{len(motion)} at {motion.period_s * 1e3:g} ms"))
-    rows.append(("max speed", f"{summary['max_speed_mm_s']:.3f} mm/s"))
+    rows.append(("max speed", f"{summary['max_speed_mm_s'] * per_mm_s:.1f} {feed_unit}"))
     rows += [("wrote", summary[key]) for key in ("csv", "plot") if key in summary]
     return _report(summary, rows, [], args.json)
 
 
+def _one_line(message: str) -> str:
+    return "; ".join(part.strip() for part in str(message).splitlines() if part.strip())
+
+
+def _gcode_lines(exc: GCodeError) -> list[str]:
+    """One ``file:line: reason`` line per error the reader lists (``file: reason`` without a
+    line), then ``... and N more``."""
+    out = []
+    for e in getattr(exc, "errors", None) or (exc,):
+        where = f"{e.source or '<string>'}:{e.line}" if e.line else f"{e.source or '<string>'}"
+        out.append(f"{where}: {_one_line(e.reason)}")
+    n_more = getattr(exc, "n_more", 0)
+    if n_more:
+        out.append(f"... and {n_more} more")
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
-    args = _parser().parse_args(argv)
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a usage error (already printed)
+        return exc.code if isinstance(exc.code, int) else 2
+    enabled = sys.stderr.isatty() and not getattr(args, "json", False)
     try:
         if args.command == "machines":
             for name in available_machines():
                 print(f"{name:<16} {load_machine(name).description}")
             return 0
         if args.command == "simulate":
-            return _simulate(args)
-        return _estimate(args)
+            return _simulate(args, enabled)
+        return _estimate(args, enabled)
     except GCodeError as exc:
-        where = f"{exc.source}:{exc.line}" if exc.line else f"{exc.source}"
-        print(f"{where}: {exc.reason}", file=sys.stderr)
+        print("\n".join(_gcode_lines(exc)), file=sys.stderr)
+        return 2
+    except InputError as exc:
+        print(_one_line(str(exc)), file=sys.stderr)
         return 2
     except BrokenPipeError:  # output piped into a pager or head that stopped reading
         sys.stderr.close()
         return 0
     except ValueError as exc:
-        print(f"nctwin: {exc}", file=sys.stderr)
+        print(f"nctwin: {_one_line(str(exc))}", file=sys.stderr)
         return 2
     except OSError as exc:  # an output file that cannot be written
-        print(f"nctwin: {exc.filename}: {exc.strerror}", file=sys.stderr)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"nctwin: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("nctwin: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

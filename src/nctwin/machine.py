@@ -32,7 +32,7 @@ __all__ = [
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
 #: Tables of a profile's file that hold a kernel's settings (see :func:`load_table`).
-KERNEL_TABLES = ("fir",)
+KERNEL_TABLES = ("fir", "fanuc")
 
 _XYZ = tuple[float, float, float]
 

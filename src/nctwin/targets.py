@@ -21,7 +21,7 @@ import numpy as np
 from .motion import Motion
 from .toolpath import MotionKind, Toolpath
 
-__all__ = ["BlockTargets", "block_targets"]
+__all__ = ["CHUNK_JUNCTIONS", "BlockTargets", "block_targets"]
 
 
 @dataclass(frozen=True)
@@ -54,7 +54,52 @@ class BlockTargets:
         return float(self.time_s.sum())
 
 
-def block_targets(motion: Motion, toolpath: Toolpath, *, search_samples: int = 250) -> BlockTargets:
+#: Junctions searched at once by :func:`block_targets`: its memory is a few arrays of
+#: ``CHUNK_JUNCTIONS x (2 search_samples + 1)`` numbers (4 MB each at the defaults) however long
+#: the program (all junctions at once took 6 GB for 200,000 blocks).
+CHUNK_JUNCTIONS = 1024
+
+
+def _junction_chunk(
+    pos_axes: np.ndarray,
+    label: np.ndarray,
+    points: np.ndarray,
+    switch: np.ndarray,
+    leaving_dwell: np.ndarray,
+    offsets: np.ndarray,
+) -> np.ndarray:
+    """Sample index of the junction point of each of K junctions (eq. 1), shape (K,).
+
+    ``pos_axes`` (3, n) are the sampled positions axis by axis, ``points`` (K, 3) the commanded
+    points, ``switch`` (K,) the first sample labelled with the block after each, ``leaving_dwell``
+    (K,) whether the block before is a dwell. Every row is computed alone, so any split of the
+    junctions into chunks gives the same bits. The squared distance is summed X, then Y, then Z,
+    the order of ``((p - q) ** 2).sum(axis=-1)`` over the three axes.
+    """
+    n_samples = len(label)
+    before, after = label[switch - 1], label[switch]
+    cand = np.clip(switch[:, None] + offsets[None, :], 0, n_samples - 1)
+    d2 = (pos_axes[0][cand] - points[:, 0, None]) ** 2
+    d2 += (pos_axes[1][cand] - points[:, 1, None]) ** 2
+    d2 += (pos_axes[2][cand] - points[:, 2, None]) ** 2
+    lab = label[cand]
+    d2[(lab < before[:, None]) | (lab > after[:, None])] = np.inf
+    # a stop ties many samples at the point: arriving counts for the block that stops (the
+    # first tied sample), waiting for the dwell, so a dwell ends at the last tied sample
+    pick = np.argmin(d2, axis=1)
+    dwell = np.flatnonzero(leaving_dwell)
+    if len(dwell):
+        pick[dwell] = d2.shape[1] - 1 - np.argmin(d2[dwell, ::-1], axis=1)
+    return cand[np.arange(len(switch)), pick]
+
+
+def block_targets(
+    motion: Motion,
+    toolpath: Toolpath,
+    *,
+    search_samples: int = 250,
+    chunk_junctions: int = CHUNK_JUNCTIONS,
+) -> BlockTargets:
     """Junction points, blended lengths, times and average feeds of every block.
 
     The junction point of a commanded point is the sample nearest to it (eq. 1). It is searched
@@ -69,11 +114,15 @@ def block_targets(motion: Motion, toolpath: Toolpath, *, search_samples: int = 2
     toolpath : Toolpath
     search_samples : int
         Half-width of the search window, in samples.
+    chunk_junctions : int
+        Junctions searched at once (memory only: the result does not depend on it).
 
     Returns
     -------
     BlockTargets
     """
+    if chunk_junctions < 1:
+        raise ValueError(f"chunk_junctions = {chunk_junctions!r} is out of range: allowed >= 1")
     n = len(toolpath)
     n_samples = len(motion)
     pos, label = motion.pos_mm, motion.block
@@ -82,18 +131,16 @@ def block_targets(motion: Motion, toolpath: Toolpath, *, search_samples: int = 2
     if n > 1:
         points = toolpath.end_mm[:-1]  # N_k, between block k and k + 1
         switch = np.clip(np.searchsorted(label, np.arange(1, n), side="left"), 1, n_samples - 1)
-        before, after = label[switch - 1], label[switch]
-        offsets = np.arange(-search_samples, search_samples + 1)
-        cand = np.clip(switch[:, None] + offsets[None, :], 0, n_samples - 1)
-        d2 = ((pos[cand] - points[:, None, :]) ** 2).sum(axis=2)
-        lab = label[cand]
-        d2[(lab < before[:, None]) | (lab > after[:, None])] = np.inf
-        # a stop ties many samples at the point: arriving counts for the block that stops,
-        # waiting for the dwell, so a dwell starts at the first tied sample and ends at the last
-        first = np.argmin(d2, axis=1)
-        last = d2.shape[1] - 1 - np.argmin(d2[:, ::-1], axis=1)
         leaving_dwell = toolpath.kind[:-1] == MotionKind.DWELL
-        junction[1:n] = cand[np.arange(n - 1), np.where(leaving_dwell, last, first)]
+        offsets = np.arange(-search_samples, search_samples + 1)
+        pos_axes = np.ascontiguousarray(pos.T)
+        # the candidates of all junctions at once would be (N - 1) x (2 w + 1) x 3 floats, GBs
+        # for a long program: junctions go in chunks, each row computed as it would be alone
+        for lo in range(0, n - 1, chunk_junctions):
+            hi = min(lo + chunk_junctions, n - 1)
+            junction[1 + lo : 1 + hi] = _junction_chunk(
+                pos_axes, label, points[lo:hi], switch[lo:hi], leaving_dwell[lo:hi], offsets
+            )
         np.maximum.accumulate(junction, out=junction)
     step = np.linalg.norm(np.diff(pos, axis=0), axis=1)
     travelled = np.concatenate([[0.0], np.cumsum(step)])

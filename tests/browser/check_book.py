@@ -14,7 +14,11 @@ For every content page (``intro.html``, the other top-level pages and every ``no
   math, every math element contains MathJax output (``<mjx-container>``), with no MathJax error and
   no raw TeX (``\\(``, ``\\[``, ``$$``, ``\\frac``, ...) left in the visible text;
 * the intro and "what is simulated" pages hold math at all;
-* every notebook page holds at least one ``<table>``.
+* every notebook page holds at least one ``<table>``, and the Verdicts page exactly one;
+* laid out in a 1280 x 900 window (a script added to a temporary copy of the page measures it):
+  no visible table is wider than the text column, or scrolls sideways inside it; no code cell's
+  input is visible (the chapters hide their code under "Show code cell source"); and the visible
+  text holds no nbval marker (``NBVAL``).
 
 Exits 1 with one line per problem, 0 when every page passes.
 """
@@ -22,6 +26,7 @@ Exits 1 with one line per problem, 0 when every page passes.
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import shutil
 import subprocess
@@ -37,6 +42,7 @@ from bs4 import BeautifulSoup
 # index.html is a redirect to intro.html written by Jupyter Book; the rest are generated lists.
 NOT_CONTENT = {"index.html", "genindex.html", "search.html", "py-modindex.html"}
 PAGES_NEEDING_MATH = ("intro.html", "simulated.html")
+VERDICTS = "verdicts.html"
 CHROMIUM_FLAGS = (
     "--headless",
     "--no-sandbox",
@@ -51,6 +57,52 @@ CHROMIUM_FLAGS = (
 RAW_TEX = re.compile(r"\\[(\[]|\$\$|\\(?:frac|sum|mathrm|left|right|begin|end|sqrt|lVert|varphi)\b")
 # Elements whose text a reader does not see as prose (code is allowed to contain backslashes).
 NOT_PROSE = ("script", "style", "pre", "code", "textarea", "svg", "noscript", "template")
+WINDOW = "1280,900"
+# Measures the laid-out page once it has loaded (and MathJax had time to typeset) and writes the
+# result as JSON into <pre id="nctwin-layout">, which --dump-dom then carries out. A table
+# overflows if it is wider than the article column or if any box between it and the column
+# scrolls sideways; an element is visible if it has a layout box (a closed <details> gives none).
+LAYOUT_ID = "nctwin-layout"
+LAYOUT_JS = """
+<script>
+window.addEventListener("load", () => setTimeout(() => {
+  const col = document.querySelector("article.bd-article") || document.querySelector("main")
+    || document.body;
+  const style = getComputedStyle(col);
+  const width = col.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+  const shown = (el) => !el.closest("details:not([open])") && (el.checkVisibility
+    ? el.checkVisibility({visibilityProperty: true}) : el.getClientRects().length > 0);
+  const out = {column: width, tables: 0, overflow: [], code: [], nbval: false};
+  document.querySelectorAll("table").forEach((t) => {
+    if (!shown(t)) return;
+    out.tables += 1;
+    let box = null;
+    for (let e = t.parentElement; e && e !== col.parentElement && !box; e = e.parentElement) {
+      if (e.scrollWidth > e.clientWidth + 1 && getComputedStyle(e).overflowX !== "visible") {
+        box = e;
+      }
+    }
+    const w = Math.round(t.getBoundingClientRect().width);
+    out.column = Math.round(width);
+    if (w > width + 1 || box) {
+      const head = Array.from(t.querySelectorAll("th")).map((x) => x.textContent.trim())
+        .filter((x) => x).slice(0, 3).join(" | ");
+      const where = box ? `scrolls in ${box.tagName.toLowerCase()}.${box.classList[0]}`
+        + ` (${box.clientWidth} px)` : `column ${width} px`;
+      out.overflow.push(`${w} px wide, ${where}: ${head}`.slice(0, 140));
+    }
+  });
+  document.querySelectorAll("div.cell_input").forEach((c) => {
+    if (shown(c)) out.code.push(c.textContent.trim().split("\\n")[0].slice(0, 60));
+  });
+  out.nbval = /NBVAL/.test(document.body.innerText);
+  const pre = document.createElement("pre");
+  pre.id = "nctwin-layout";
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+}, 1000));
+</script>
+"""
 
 
 @dataclass
@@ -60,6 +112,7 @@ class PageReport:
     math: int = 0
     rendered: int = 0
     tables: int = 0
+    column_px: int = 0
     seconds: float = 0.0
 
 
@@ -102,7 +155,15 @@ def check_static(path: Path, html_dir: Path, report: PageReport) -> None:
 
 
 def render(path: Path, chromium: str, budget_ms: int, timeout_s: int) -> tuple[str | None, str]:
-    """The DOM after Chromium ran the page's scripts, or None and the reason."""
+    """The DOM after Chromium ran the page's scripts (and :data:`LAYOUT_JS`), or None and why.
+
+    Chromium opens a copy of the page, beside it so that relative links resolve, with the
+    layout script added before ``</body>``; the copy is removed afterwards.
+    """
+    html = path.read_text(encoding="utf-8")
+    at = html.rfind("</body>")
+    copy = path.with_name(f".layout-{path.name}")
+    copy.write_text(html[:at] + LAYOUT_JS + html[at:], encoding="utf-8")
     profile = tempfile.mkdtemp(prefix="nctwin-chromium-")
     try:
         cmd = [
@@ -111,13 +172,15 @@ def render(path: Path, chromium: str, budget_ms: int, timeout_s: int) -> tuple[s
             chromium,
             *CHROMIUM_FLAGS,
             f"--user-data-dir={profile}",
+            f"--window-size={WINDOW}",
             "--dump-dom",
             f"--virtual-time-budget={budget_ms}",
-            path.resolve().as_uri(),
+            copy.resolve().as_uri(),
         ]
         proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     finally:
         shutil.rmtree(profile, ignore_errors=True)
+        copy.unlink(missing_ok=True)
     if proc.returncode != 0 or "<html" not in proc.stdout:
         tail = " | ".join(proc.stderr.strip().splitlines()[-5:])
         why = "timed out" if proc.returncode == 124 else f"exit code {proc.returncode}"
@@ -132,9 +195,28 @@ def visible_text(soup: BeautifulSoup) -> str:
     return body.get_text(" ")
 
 
+def check_layout(soup: BeautifulSoup, report: PageReport) -> None:
+    """Checks on what :data:`LAYOUT_JS` measured: tables fit, code hidden, no nbval marker."""
+    tag = soup.find(id=LAYOUT_ID)
+    if tag is None:
+        report.problems.append("the layout script did not run (no measurements in the DOM)")
+        return
+    layout = json.loads(tag.get_text())
+    tag.decompose()
+    report.column_px = layout["column"]
+    report.problems += [f"table overflows its column: {o}" for o in layout["overflow"]]
+    if layout["code"]:
+        report.problems.append(
+            f"{len(layout['code'])} code cell input(s) visible, e.g. {layout['code'][0]!r}"
+        )
+    if layout["nbval"]:
+        report.problems.append("nbval marker text (NBVAL) visible on the page")
+
+
 def check_dom(dom: str, report: PageReport, is_notebook: bool) -> None:
     """Checks on the DOM after MathJax ran."""
     soup = BeautifulSoup(dom, "html.parser")
+    check_layout(soup, report)
     report.tables = len(soup.find_all("table"))
     maths = soup.select("span.math, div.math")
     report.rendered = sum(1 for m in maths if m.find("mjx-container") is not None)
@@ -158,6 +240,8 @@ def check_dom(dom: str, report: PageReport, is_notebook: bool) -> None:
         report.problems.append("page should hold math but has none")
     if is_notebook and report.tables == 0:
         report.problems.append("notebook page shows no <table>")
+    if report.page == VERDICTS and report.tables != 1:
+        report.problems.append(f"the Verdicts page should hold one table, found {report.tables}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -177,6 +261,9 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
     reports = []
+    if not (html_dir / VERDICTS).is_file():
+        reports.append(PageReport(VERDICTS, ["page missing (make book writes verdicts.md)"]))
+        print(f"check_book: FAIL {VERDICTS}: page missing")
     for path in content_pages(html_dir):
         rel = path.relative_to(html_dir).as_posix()
         report = PageReport(rel)
@@ -191,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
         status = "ok  " if not report.problems else "FAIL"
         print(
             f"check_book: {status} {rel:<32} math {report.rendered}/{report.math} typeset, "
-            f"{report.tables} table(s), {report.seconds:.1f} s"
+            f"{report.tables} table(s), column {report.column_px} px, {report.seconds:.1f} s"
         )
         for problem in report.problems:
             print(f"check_book:      {rel}: {problem}")

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..cache import atomic_savez, cache_path, content_key
+from ..kernel.fir import FirFilter
 from ..physics import cutting, drives
 from ..runner import run_tasks
 
@@ -24,6 +25,8 @@ __all__ = [
     "AirMoves",
     "Process",
     "Recorded",
+    "Windows",
+    "process_windows",
     "run_air_moves",
     "run_processes",
 ]
@@ -86,14 +89,14 @@ def _segment(
     length_mm: float, speed_mm_s: float, dt: float, t1_s: float = 0.06, t2_s: float = 0.015
 ):
     """Arc length (n,) of one segment travelled at ``speed_mm_s`` from rest to rest: a
-    rectangular velocity pulse smoothed by two moving averages (FIR interpolation, jerk-limited).
+    rectangular velocity pulse, held at rest outside its span, through the interpolator's FIR
+    filter (:class:`nctwin.kernel.fir.FirFilter`, jerk-limited), then integrated.
     """
     pulse = np.full(max(round(length_mm / speed_mm_s / dt), 1), speed_mm_s)
-    pulse *= length_mm / (pulse.sum() * dt)
-    for tau in (t1_s, t2_s):
-        k = max(round(tau / dt), 1)
-        pulse = np.convolve(pulse, np.full(k, 1.0 / k))
-    return np.concatenate([[0.0], np.cumsum(pulse) * dt])
+    held = np.zeros((3, len(pulse) + 2))
+    held[0, 1:-1] = pulse * length_mm / (pulse.sum() * dt)
+    vel = FirFilter(t1_s, t2_s, dt).apply(held)[0]
+    return np.concatenate([[0.0], np.cumsum(vel) * dt])
 
 
 def _hold(n_total: int, *parts: np.ndarray) -> np.ndarray:
@@ -192,6 +195,67 @@ def _process_signals(p: Process, n_steps: int, dt: float):
 
 
 @dataclass(frozen=True, eq=False)
+class Windows:
+    """Where each recorded sample lies: in the cut, moving, at a reversal (set points).
+
+    Parameters
+    ----------
+    cutting : ndarray of bool, shape (P, R)
+        The tool is in the material (engagement weight > 0, or plunging).
+    moving : ndarray of bool, shape (P, R, 3)
+        The axis' set-point velocity is not zero (else the axis stands still).
+    reversal : ndarray of bool, shape (P, R, 3)
+        Within ``reversal_s`` of a sign change of the axis' set-point velocity while cutting.
+    """
+
+    cutting: np.ndarray
+    moving: np.ndarray
+    reversal: np.ndarray
+
+
+def process_windows(
+    processes: list[Process],
+    machine: drives.FeedDriveMachine,
+    *,
+    duration_s: float,
+    reversal_s: float = 0.1,
+) -> Windows:
+    """The scoring windows of every process, on the recorded samples (every
+    ``machine.decimation``-th servo step, from the first).
+
+    Parameters
+    ----------
+    processes : list of Process
+    machine : FeedDriveMachine
+    duration_s : float
+        Length of every run, as in :func:`run_processes`.
+    reversal_s : float
+        Half width of a reversal window (s), > 0.
+
+    Returns
+    -------
+    Windows
+    """
+    if not reversal_s > 0.0:
+        raise ValueError(f"reversal_s = {reversal_s!r} is out of range: allowed > 0")
+    dt = 1.0 / machine.servo_rate_hz
+    n = round(duration_s * machine.servo_rate_hz)
+    half = round(reversal_s * machine.record_rate_hz)
+    cutting, moving, reversal = [], [], []
+    for p in processes:
+        pos, _, weight, _, flag = _trajectory(p, n, dt)
+        vel = np.gradient(pos, dt, axis=0)[:: machine.decimation]
+        cut = ((weight > 0) & (flag > 0))[:: machine.decimation]
+        flips = np.zeros(vel.shape, dtype=bool)
+        flips[1:] = vel[1:] * vel[:-1] < 0
+        near = np.stack([np.convolve(f, np.ones(2 * half + 1), "same") > 0 for f in flips.T], 1)
+        cutting.append(cut)
+        moving.append(np.abs(vel) > 1e-9)
+        reversal.append(near & cut[:, None])
+    return Windows(np.array(cutting), np.array(moving), np.array(reversal))
+
+
+@dataclass(frozen=True, eq=False)
 class Recorded:
     """What the controller and the dynamometer recorded for every process.
 
@@ -277,7 +341,7 @@ def run_processes(
         "duration_s": duration_s,
         "seed": seed,
         "batch_size": batch_size,
-        "version": 1,
+        "version": 2,
     }
     path = cache_path("denkena2020", "processes", content_key(key), ".npz")
     if path.exists():
@@ -356,7 +420,7 @@ def run_air_moves(
         "accel": list(accel_speeds_mm_s),
         "accel_mm": accel_mm,
         "duration_s": duration_s,
-        "version": 1,
+        "version": 2,
     }
     path = cache_path("denkena2020", "air", content_key(key), ".npz")
     kinds, speeds, refs = [], [], []

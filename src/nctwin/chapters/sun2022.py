@@ -1,17 +1,20 @@
-"""Sun et al. (2022): one feed-forward network per axis predicts the axis feeds at every cutter
-location, and from them the machining time.
+"""Sun, Dominguez-Caballero, Ward, Ayvar-Soberanis & Curtis (2022): one feed-forward network per
+axis predicts the axis feeds at every cutter location, and from them the machining time.
 
 The chapter's pipeline, kept out of the notebook:
 
 1. :func:`run_pockets` runs the eight pocket programs of :mod:`nctwin.programs.thinwall` on the
    FIR kernel (the "machine"), records each at about 5 Hz with jitter (the paper's measuring
    device), and pairs every cutter location with the nearest record (the paper's targets). It
-   also keeps the true axis feeds at each cutter location (1 kHz), which the paper did not have.
-2. :func:`train_axis_models` fits one network per axis (Table 1 features, 2 hidden tanh layers of
-   5 and 10, linear output, MSE) on the training pockets of Table 2, validating on the first half
-   of pocket 4, with :func:`nctwin.learn.train.fit`.
-3. :func:`predict_time` turns the predicted axis feeds into the resultant feed (eq. 9) and the
-   machining time (eq. 10).
+   also keeps the block-average axis feeds at each cutter location (1 kHz), which the paper did
+   not have. :func:`part_stats` and :func:`machine_check` put the part and the machine beside
+   the paper's published statistics.
+2. :func:`train_ensembles` fits one network per axis (Table 1 features, 2 hidden tanh layers of
+   5 and 10, linear output, MSE) on the training pockets of Table 2 (:data:`MODELS`), validating
+   on the first half of pocket 4, once per seed of :data:`SEEDS`, the seeds in parallel through
+   :func:`nctwin.runner.run_tasks`.
+3. :func:`predict_time` averages the seeds' predicted axis feeds (the ensemble) and turns them
+   into the resultant feed (eq. 9) and the machining time (eq. 10).
 """
 
 from __future__ import annotations
@@ -31,23 +34,52 @@ from ..machine import MachineProfile
 from ..methods import sun2022 as sun
 from ..motion import Motion
 from ..physics.measure import ControllerSamples, controller_samples, nearest_sample
-from ..programs.thinwall import HOME_MM, POCKETS, pocket_program
+from ..programs.thinwall import POCKETS, pocket_program, start_mm
 from ..report.tables import Claim, error_pct
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath
 
 __all__ = [
+    "MODELS",
+    "SEEDS",
+    "TRAIN_CONFIG",
     "PocketRun",
     "claims",
-    "oracle_time",
+    "error_sources",
+    "machine_check",
+    "part_stats",
+    "predict_all_feeds",
     "predict_feeds",
     "predict_time",
+    "predict_times",
     "run_pocket",
     "run_pockets",
+    "seed_table",
+    "target_time",
     "time_table",
-    "train_axis_models",
+    "train_ensembles",
+    "training_table",
 ]
+
+#: Training pockets of the paper's two models (Table 2); both validate on the first half of
+#: pocket 4 and leave its second half as the test set.
+MODELS = {"model #1": (1,), "model #2": (1, 5, 8)}
+
+#: Seeds of the ensembles: each seed initialises and shuffles one network per axis.
+SEEDS = (0, 1, 2, 3, 4)
+
+#: Training: MSE (the paper's loss), Adam, early stopping on the validation half of pocket 4
+#: after 50 epochs without improvement. The epoch cap is far above where training stops, so
+#: that it never decides (:func:`training_table` reports it).
+TRAIN_CONFIG = TrainConfig(
+    loss="mse", window_lines=256, batch_size=8, max_epochs=3000, patience=50, learning_rate=1e-2
+)
+
+#: Targets: the record nearest to each cutter location (the paper's, ~5 Hz), or the 1 kHz
+#: block-average axis feed (an ablation the paper could not run).
+TARGETS = ("measured", "true")
+
 
 @dataclass(frozen=True, eq=False)
 class PocketRun:
@@ -65,7 +97,8 @@ class PocketRun:
     features : ndarray, shape (N, 3, 9)
         :func:`nctwin.methods.sun2022.features`.
     measured_feed_mm_s : ndarray, shape (N, 3)
-        Axis feeds of the record nearest to each cutter location (the paper's targets).
+        Axis feeds of the record nearest to each cutter location (the paper's targets); for a
+        rapid, the nearest of the records taken while the tool was on it (see :func:`run_pocket`).
     true_feed_mm_s : ndarray, shape (N, 3)
         Average axis feeds over each block, from the 1 kHz motion: the displacement between
         the junction points before and after cutter location n over the time between them
@@ -92,6 +125,12 @@ class PocketRun:
         """Machining time on the machine."""
         return self.motion.cycle_time_s
 
+    def target(self, target: str) -> np.ndarray:
+        """The axis-feed targets, shape (N, 3): ``"measured"`` (5 Hz) or ``"true"`` (1 kHz)."""
+        if target not in TARGETS:
+            raise ValueError(f"target = {target!r} is unknown: allowed {', '.join(TARGETS)}")
+        return self.measured_feed_mm_s if target == "measured" else self.true_feed_mm_s
+
 
 def run_pocket(
     text: str,
@@ -99,11 +138,21 @@ def run_pocket(
     machine: MachineProfile,
     seed: int = 0,
     *,
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
     rate_hz: float = 5.0,
     jitter_s: float = 0.03,
 ) -> PocketRun:
-    """Run one pocket program on the FIR kernel and record it; see the module docstring."""
-    parsed = parse(text, start_mm=HOME_MM, source=f"pocket {number}")
+    """Run one pocket program from ``start`` (mm) on the FIR kernel and record it.
+
+    Every cutter location is paired with the record nearest to it in space among those within
+    2 s of the tool's passage (the paper's target). A rapid's cutter location is where the tool
+    stops before the plunge, so the record nearest to it is typically taken in the stop; the
+    paper's Fig. 9 shows its G0 targets as fast feeds, below 30,000 mm/min but not near zero, so
+    a rapid is paired with the nearest of the records taken while the tool was on it (the
+    nearest of all if the logger took none then). The paper does not say how; this is the
+    chapter's choice.
+    """
+    parsed = parse(text, start_mm=start, source=f"pocket {number}")
     tp = parsed.take(parsed.lengths_mm > 0)
     motion = fir.run(tp, machine, fir_settings(machine))
     junction = block_targets(motion, tp).junction_sample
@@ -112,8 +161,10 @@ def run_pocket(
     moved = np.diff(motion.pos_mm[junction], axis=0)
     block_avg = np.divide(moved, dt, out=np.zeros_like(moved), where=dt > 0)
     records = controller_samples(motion, rate_hz=rate_hz, jitter_s=jitter_s, seed=seed)
-    nearest = nearest_sample(records, tp.end_mm, motion.t_s[passage])
-    commanded = np.where(tp.kind == MotionKind.RAPID, machine.rapid_feed_mm_s, tp.feed_mm_s)
+    rapid = tp.kind == MotionKind.RAPID
+    since = np.where(rapid, motion.t_s[junction[:-1]], np.nan)
+    nearest = nearest_sample(records, tp.end_mm, motion.t_s[passage], since_s=since)
+    commanded = np.where(rapid, machine.rapid_feed_mm_s, tp.feed_mm_s)
     return PocketRun(
         number=number,
         toolpath=tp,
@@ -130,131 +181,282 @@ def run_pocket(
 def run_pockets(
     machine: MachineProfile, *, seed: int = 0, n_jobs: int = 1, **kwargs
 ) -> dict[int, PocketRun]:
-    """All eight pockets, in parallel through joblib (``n_jobs``); each pocket's record jitter
-    is seeded with ``seed + number``. ``kwargs`` go to :func:`run_pocket`."""
-    tasks = ((pocket_program(spec), spec.number, machine, seed + spec.number) for spec in POCKETS)
-    runs = run_tasks(functools.partial(run_pocket, **kwargs), tasks, n_jobs=n_jobs)
+    """All eight pockets, in parallel (``n_jobs``), each from its :func:`start_mm`; each pocket's
+    record jitter is seeded with ``seed + number``. ``kwargs`` go to :func:`run_pocket`."""
+    tasks = (
+        (pocket_program(spec), spec.number, machine, seed + spec.number, start_mm(spec))
+        for spec in POCKETS
+    )
+    runs = run_tasks(functools.partial(_run_pocket_from, **kwargs), tasks, n_jobs=n_jobs)
     return {r.number: r for r in runs}
 
 
-def _half(run: PocketRun, second: bool) -> slice:
-    mid = len(run.toolpath) // 2
-    return slice(mid, None) if second else slice(0, mid)
+def _run_pocket_from(text, number, machine, seed, start, **kwargs) -> PocketRun:
+    return run_pocket(text, number, machine, seed, start=start, **kwargs)
 
 
-def train_axis_models(
-    runs: dict[int, PocketRun],
-    train_pockets: tuple[int, ...],
-    *,
-    validation_pocket: int = 4,
-    target: str = "measured",
-    train_config: TrainConfig | None = None,
-    name: str = "sun2022",
-) -> list[Trained]:
-    """One network per axis (X, Y, Z), trained on ``train_pockets`` and validated on the first
-    half of ``validation_pocket`` (Sun et al. 2022, Table 2).
+def part_stats(
+    runs: dict[int, PocketRun], paper3: pd.DataFrame, summary: pd.DataFrame
+) -> pd.DataFrame:
+    """The part beside the paper's: per pocket the cutter locations, records, rapids, path
+    length, CAD/CAM and measured times, and the paper's numbers where it gives them (Table 3;
+    cutter locations and records of pocket 1 only, Sec. 4.1).
 
     Parameters
     ----------
     runs : dict of PocketRun
-    train_pockets : tuple of int
-        Pockets to train on (model #1: ``(1,)``; model #2: ``(1, 5, 8)``).
-    validation_pocket : int
-        Its first half validates (early stopping); its second half is the test set.
-    target : {"measured", "true"}
-        The 5 Hz nearest record (the paper's) or the 1 kHz block-average axis feed.
-    train_config : TrainConfig, optional
-        Defaults to MSE loss, seed 0.
-    name : str
-        Checkpoint name prefix.
+    paper3 : pandas.DataFrame
+        ``data/papers/sun2022_table3.csv``.
+    summary : pandas.DataFrame
+        ``data/papers/sun2022_summary.csv``.
     """
-    if target not in ("measured", "true"):
-        raise ValueError(f"target = {target!r} is unknown: allowed measured, true")
-    cfg = train_config or TrainConfig(
-        loss="mse", window_lines=256, batch_size=8, max_epochs=400, patience=40, learning_rate=1e-2
-    )
-    val_run = runs[validation_pocket]
-    first = _half(val_run, second=False)
-    models = []
-    for axis in range(3):
-
-        def ys(run: PocketRun, sl: slice = slice(None), a: int = axis) -> np.ndarray:
-            feed = run.measured_feed_mm_s if target == "measured" else run.true_feed_mm_s
-            return feed[sl, a : a + 1]
-
-        models.append(
-            fit(
-                sun.MODEL_CONFIG,
-                cfg,
-                [runs[p].features[:, axis] for p in train_pockets],
-                [ys(runs[p]) for p in train_pockets],
-                validation=([val_run.features[first, axis]], [ys(val_run, first)]),
-                name=f"{name}-{target}-{'-'.join(map(str, train_pockets))}-{'xyz'[axis]}",
-                progress=False,
-            )
-        )
-    return models
-
-
-def predict_feeds(models: list[Trained], run: PocketRun) -> np.ndarray:
-    """Predicted axis feeds at every cutter location, shape (N, 3)."""
-    return np.column_stack([m.predict(run.features[:, a])[:, 0] for a, m in enumerate(models)])
-
-
-def predict_time(models: list[Trained], run: PocketRun) -> tuple[float, np.ndarray]:
-    """Machining time from the predicted axis feeds (eq. 9-10).
-
-    Returns the time (s) and the resultant feed at each cutter location, shape (N,). The
-    resultant feed is kept above :data:`MIN_FEED_SHARE` of the commanded feed.
-    """
-    feeds = predict_feeds(models, run)
-    t = sun.block_times_s(feeds, run.toolpath.lengths_mm, run.commanded_mm_s)
-    return float(t.sum()), sun.resultant_feed_mm_s(feeds, run.commanded_mm_s)
-
-
-def time_table(runs: dict[int, PocketRun], models: list[Trained]) -> pd.DataFrame:
-    """Per pocket: measured, CAD/CAM and network machining times with errors (Tables 3-4).
-
-    Errors are signed, (predicted - measured) / measured * 100: negative is an underestimate.
-    """
+    quantity = summary.set_index("quantity")["value"]
+    paper = paper3.set_index("pocket")
     rows = []
-    for k, run in runs.items():
-        nn_s, _ = predict_time(models, run)
-        rows.append(
-            {
-                "pocket": k,
-                "measured_s": run.measured_s,
-                "cam_s": run.cam_s,
-                "cam_err_pct": error_pct(run.cam_s, run.measured_s, signed=True),
-                "nn_s": nn_s,
-                "nn_err_pct": error_pct(nn_s, run.measured_s, signed=True),
-            }
-        )
+    for k, r in runs.items():
+        rows.append({
+            "pocket": k,
+            "cutter_locations": len(r.toolpath),
+            "records": len(r.records.t_s),
+            "rapids": int((r.toolpath.kind == MotionKind.RAPID).sum()),
+            "length_mm": r.toolpath.length_mm,
+            "mean_cl_spacing_mm": r.toolpath.length_mm / len(r.toolpath),
+            "cam_s": r.cam_s,
+            "measured_s": r.measured_s,
+            "paper_cutter_locations": quantity["pocket1_commanded_points"] if k == 1 else np.nan,
+            "paper_records": quantity["pocket1_measured_points"] if k == 1 else np.nan,
+            "paper_cam_s": paper.loc[k, "cam_s"],
+            "paper_measured_s": paper.loc[k, "measured_s"],
+        })  # fmt: skip
     return pd.DataFrame(rows)
 
 
-def oracle_time(run: PocketRun, target: str = "measured") -> float:
-    """Eq. 10 fed with the targets themselves: what a perfect network would give."""
-    feed = run.measured_feed_mm_s if target == "measured" else run.true_feed_mm_s
-    return float(sun.block_times_s(feed, run.toolpath.lengths_mm, run.commanded_mm_s).sum())
+def machine_check(runs: dict[int, PocketRun], paper3: pd.DataFrame) -> pd.DataFrame:
+    """The machine against what the paper states: per pocket the programmed G1 feed, the fastest
+    rapid (the paper's G0 at 30,000 mm/min is never reached) and the CAD/CAM error beside the
+    paper's (signed; negative: CAD/CAM under the measured time)."""
+    paper = paper3.set_index("pocket")
+    rows = []
+    for k, r in runs.items():
+        rapid = np.isin(r.motion.block, np.flatnonzero(r.toolpath.kind == MotionKind.RAPID))
+        cutting = r.toolpath.kind == MotionKind.LINEAR
+        rows.append({
+            "pocket": k,
+            "g1_feed_mm_min": 60 * float(r.toolpath.feed_mm_s[cutting].max()),
+            "fastest_rapid_mm_min": 60 * float(r.motion.speed_mm_s[rapid].max(initial=0.0)),
+            "g0_mm_min": 60 * float(r.commanded_mm_s.max()),
+            "cam_err_pct": error_pct(r.cam_s, r.measured_s, signed=True),
+            "paper_cam_err_pct": -float(paper.loc[k, "cam_err_pct"]),
+        })  # fmt: skip
+    return pd.DataFrame(rows)
 
 
-def claims(runs: dict[int, PocketRun], sources: pd.DataFrame, table3: pd.DataFrame) -> list[Claim]:
-    """The paper's claims, on its own set-up (5 Hz targets) and, as a separate row each, with
-    1 kHz block-average targets; the tolerances are the paper's own numbers.
+def _train_task(
+    data: dict[int, tuple[np.ndarray, np.ndarray]],
+    train_pockets: tuple[int, ...],
+    validation: tuple[np.ndarray, np.ndarray],
+    target: str,
+    seed: int,
+) -> list[Trained]:
+    """One network per axis on plain arrays (what a worker receives)."""
+    cfg = TrainConfig(**{**TRAIN_CONFIG.to_dict(), "seed": seed})
+    vx, vy = validation
+    name = f"sun2022-{target}-{'-'.join(map(str, train_pockets))}"
+    return [
+        fit(
+            sun.MODEL_CONFIG,
+            cfg,
+            [data[p][0][:, a] for p in train_pockets],
+            [data[p][1][:, a : a + 1] for p in train_pockets],
+            validation=([vx[:, a]], [vy[:, a : a + 1]]),
+            name=f"{name}-{'xyz'[a]}",
+            progress=False,
+        )
+        for a in range(3)
+    ]
 
-    Model #1's error is under 10 % on every pocket; model #2's is at most 3 % on every pocket and
-    lower than model #1's on the pockets model #1 did not see (all but pocket 1); CAD/CAM
-    underestimates every pocket.
+
+def _task_args(runs, train_pockets, target, seed, validation_pocket):
+    val = runs[validation_pocket]
+    first = slice(0, len(val.toolpath) // 2)  # the first half validates, the rest is the test set
+    data = {p: (runs[p].features, runs[p].target(target)) for p in train_pockets}
+    return (
+        data,
+        tuple(train_pockets),
+        (val.features[first], val.target(target)[first]),
+        target,
+        seed,
+    )
+
+
+def train_ensembles(
+    runs: dict[int, PocketRun],
+    *,
+    seeds: tuple[int, ...] = SEEDS,
+    targets: tuple[str, ...] = TARGETS,
+    n_jobs: int = 2,
+) -> dict[tuple[str, str], list[list[Trained]]]:
+    """Every model of :data:`MODELS` on every target, once per seed, the seeds in parallel.
+
+    Returns
+    -------
+    dict
+        ``(model name, target) -> [per seed: [X, Y, Z network]]``.
+    """
+    keys = [(name, target, seed) for name in MODELS for target in targets for seed in seeds]
+    tasks = [_task_args(runs, MODELS[name], target, seed, 4) for name, target, seed in keys]
+    trained = run_tasks(_train_task, tasks, n_jobs=n_jobs)
+    out: dict[tuple[str, str], list[list[Trained]]] = {}
+    for (name, target, _), models in zip(keys, trained, strict=True):
+        out.setdefault((name, target), []).append(models)
+    return out
+
+
+def training_table(ensembles: dict[tuple[str, str], list[list[Trained]]]) -> pd.DataFrame:
+    """Per model, target, seed and axis: the best (kept) epoch, the epochs run, and whether early
+    stopping ended the training (``stopped_early``; otherwise the epoch cap did)."""
+    rows = []
+    for (name, target), members in ensembles.items():
+        for models in members:
+            for axis, m in zip("xyz", models, strict=True):
+                run = len(m.history["val"])
+                rows.append({
+                    "model": name, "target": target, "seed": m.train_config.seed, "axis": axis,
+                    "best_epoch": m.best_epoch, "epochs_run": run,
+                    "stopped_early": run < m.train_config.max_epochs,
+                })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def predict_feeds(members: list[list[Trained]], run: PocketRun) -> np.ndarray:
+    """Predicted axis feeds at every cutter location, shape (N, 3): the mean over the members
+    (one member per seed, each ``[X, Y, Z network]``; a one-member list is one seed)."""
+    return predict_all_feeds(members, [run])[0]
+
+
+def predict_all_feeds(members: list[list[Trained]], runs: list[PocketRun]) -> list[np.ndarray]:
+    """:func:`predict_feeds` of several pockets, each network run once over all of them."""
+    x = np.concatenate([r.features for r in runs])
+    feeds = np.mean(
+        [np.column_stack([m.predict(x[:, a])[:, 0] for a, m in enumerate(models)])
+         for models in members],
+        axis=0,
+    )
+    return np.split(feeds, np.cumsum([len(r.features) for r in runs])[:-1])
+
+
+def predict_time(members: list[list[Trained]], run: PocketRun) -> tuple[float, np.ndarray]:
+    """Machining time from the predicted axis feeds (eq. 9-10, every block, rapids included).
+
+    Returns the time (s) and the resultant feed at each cutter location, shape (N,)
+    (:func:`nctwin.methods.sun2022.resultant_feed_mm_s`).
+    """
+    return predict_times(members, [run])[0]
+
+
+def predict_times(
+    members: list[list[Trained]], runs: list[PocketRun]
+) -> list[tuple[float, np.ndarray]]:
+    """:func:`predict_time` of several pockets, each network run once over all of them."""
+    out = []
+    for run, feeds in zip(runs, predict_all_feeds(members, runs), strict=True):
+        t = sun.block_times_s(feeds, run.toolpath.lengths_mm, run.commanded_mm_s)
+        out.append((float(t.sum()), sun.resultant_feed_mm_s(feeds, run.commanded_mm_s)))
+    return out
+
+
+def time_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.DataFrame:
+    """Per pocket: measured, CAD/CAM and network (ensemble) machining times with errors
+    (Tables 3-4). Errors are signed, (predicted - measured) / measured * 100."""
+    rows = []
+    for k, run in runs.items():
+        nn_s, _ = predict_time(members, run)
+        rows.append({
+            "pocket": k, "measured_s": run.measured_s, "cam_s": run.cam_s,
+            "cam_err_pct": error_pct(run.cam_s, run.measured_s, signed=True),
+            "nn_s": nn_s, "nn_err_pct": error_pct(nn_s, run.measured_s, signed=True),
+        })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def seed_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.DataFrame:
+    """Per pocket, each seed's signed error (``seed_<s>_err_pct``), the ensemble's
+    (``ensemble_err_pct``: the mean of the seeds' feeds through eq. 9-10, the reported network)
+    and the spread of the seeds (mean, standard deviation, min, max)."""
+    rows = []
+    for k, run in runs.items():
+        errs = {
+            f"seed_{models[0].train_config.seed}_err_pct": error_pct(
+                predict_time([models], run)[0], run.measured_s, signed=True
+            )
+            for models in members
+        }
+        e = np.array(list(errs.values()))
+        rows.append({
+            "pocket": k, **errs,
+            "ensemble_err_pct": error_pct(predict_time(members, run)[0], run.measured_s,
+                                          signed=True),
+            "seed_mean_err_pct": e.mean(), "seed_std_err_pct": e.std(ddof=1) if len(e) > 1 else 0.0,
+            "seed_min_err_pct": e.min(), "seed_max_err_pct": e.max(),
+        })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def target_time(run: PocketRun, target: str = "measured", kinds=None) -> float:
+    """Eq. 10 fed with the targets themselves, over the blocks of ``kinds`` (all if None).
+
+    Its error against the measured time is the bias of the target definition: what the
+    targets, not a network, put into eq. 10.
+    """
+    t = sun.block_times_s(run.target(target), run.toolpath.lengths_mm, run.commanded_mm_s)
+    if kinds is not None:
+        t = t[np.isin(run.toolpath.kind, kinds)]
+    return float(t.sum())
+
+
+def error_sources(
+    runs: dict[int, PocketRun], ensembles: dict[tuple[str, str], list[list[Trained]]]
+) -> pd.DataFrame:
+    """Per pocket and target: the bias of the target definition (eq. 10 fed with the targets;
+    ``bias_<t>_err_pct``), the share of it in the rapids (``bias_<t>_rapids_s``: the targets'
+    rapid time minus the machine's) and the ensembles' errors (``m1_<t>_err_pct``,
+    ``m2_<t>_err_pct``); ``<t>`` is ``5hz`` or ``1khz``."""
+    rows = []
+    for k, run in runs.items():
+        row = {"pocket": k, "measured_s": run.measured_s}
+        rapid = np.isin(run.motion.block, np.flatnonzero(run.toolpath.kind == MotionKind.RAPID))
+        for target, label in (("measured", "5hz"), ("true", "1khz")):
+            row[f"bias_{label}_err_pct"] = error_pct(
+                target_time(run, target), run.measured_s, signed=True
+            )
+            row[f"bias_{label}_rapids_s"] = (
+                target_time(run, target, [MotionKind.RAPID]) - rapid.sum() * run.motion.period_s
+            )
+            for name, short in (("model #1", "m1"), ("model #2", "m2")):
+                if (name, target) in ensembles:
+                    t, _ = predict_time(ensembles[name, target], run)
+                    row[f"{short}_{label}_err_pct"] = error_pct(t, run.measured_s, signed=True)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+#: Pockets on which the paper's model #2 improved on model #1 (Sec. 4.2: "though the error for
+#: pocket #1 and #4 was slightly increased, the error for other pockets was improved").
+IMPROVED_POCKETS = (2, 3, 5, 6, 7, 8)
+
+
+def claims(sources: pd.DataFrame, table3: pd.DataFrame) -> list[Claim]:
+    """The paper's claims at its own level, judged on the ensemble mean of the seeds, on its own
+    set-up (5 Hz targets) and, as a separate row each, with 1 kHz block-average targets.
+
+    Model #1's error is under 10 % on every pocket (Sec. 4.1, Table 3); model #2's is at most
+    3 % on every pocket (Sec. 4.2, Table 4) and lower than model #1's on every pocket but 1 and
+    4 (Sec. 4.2); CAD/CAM underestimates every pocket (Table 3).
 
     Parameters
     ----------
-    runs : dict
-        ``pocket -> PocketRun`` (only the keys are read: the pockets).
     sources : pandas.DataFrame
-        One row per pocket with ``pocket`` and the signed errors ``m1_5hz_err_pct``,
-        ``m2_5hz_err_pct``, ``m1_1khz_err_pct``, ``m2_1khz_err_pct`` (the chapter's
-        ``error_sources`` table).
+        :func:`error_sources`.
     table3 : pandas.DataFrame
         Table 3 (columns ``cam_s``, ``measured_s``).
 
@@ -262,23 +464,29 @@ def claims(runs: dict[int, PocketRun], sources: pd.DataFrame, table3: pd.DataFra
     -------
     list of Claim
     """
-    unseen = [k for k in runs if k != 1]
+    err = sources.set_index("pocket")
+    improved = list(IMPROVED_POCKETS)
     claims = []
-    for target, label in (("measured", "5 Hz records"), ("true", "1 kHz block averages")):
-        err = sources.set_index("pocket")
-        key = "5hz" if target == "measured" else "1khz"
+    for key, label in (("5hz", "5 Hz records"), ("1khz", "1 kHz block averages")):
         m1, m2 = err[f"m1_{key}_err_pct"].abs(), err[f"m2_{key}_err_pct"].abs()
         claims += [
             Claim(f"model1_below_10pct_{key}", f"model #1 error < 10 % on every pocket ({label})",
                   m1.max(), "<", 10.0),
             Claim(f"model2_below_3pct_{key}", f"model #2 error <= 3 % on every pocket ({label})",
                   m2.max(), "<=", 3.0),
-            Claim(f"model2_beats_model1_unseen_{key}",
-                  f"model #2 error lower than model #1 on every pocket model #1 did not see "
-                  f"({label}); value: largest (model #2 - model #1) in percentage points",
-                  (m2[unseen] - m1[unseen]).max(), "<", 0.0),
+            Claim(f"model2_improves_2_3_5_6_7_8_{key}",
+                  f"model #2 error lower than model #1 on pockets 2, 3, 5, 6, 7, 8 ({label}); "
+                  f"value: largest (model #2 - model #1) in percentage points",
+                  (m2[improved] - m1[improved]).max(), "<", 0.0),
         ]  # fmt: skip
     cam_under = (table3["cam_s"] < table3["measured_s"]).all()
-    claims.append(Claim("cam_underestimates", "CAD/CAM underestimates every pocket (1 = all)",
-                        float(cam_under), "==", 1.0))
+    claims.append(
+        Claim(
+            "cam_underestimates",
+            "CAD/CAM underestimates every pocket (1 = all)",
+            float(cam_under),
+            "==",
+            1.0,
+        )
+    )
     return claims

@@ -17,7 +17,6 @@ from ..machine import MachineProfile
 from ..paths import results_dir
 from ..recordings import MACHINE as RECORDED_MACHINE
 from ..toolpath import Toolpath
-from . import learned
 from .blend_planner import blend_planner
 from .block_overlap import block_overlap
 from .cam import cam
@@ -35,14 +34,29 @@ __all__ = [
 ]
 
 
+def _bilstm(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+    """:func:`nctwin.estimate.learned.bilstm`, imported on first use (torch takes seconds to
+    import, and the other methods do not need it)."""
+    from .learned import bilstm
+
+    return bilstm(toolpath, machine)
+
+
+def _axis_nn(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+    """:func:`nctwin.estimate.learned.axis_nn`, imported on first use."""
+    from .learned import axis_nn
+
+    return axis_nn(toolpath, machine)
+
+
 #: Estimators by name.
 METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
     "cam": cam,
     "kernel": kernel,
     "block_overlap": block_overlap,
     "planner": blend_planner,
-    "bilstm": learned.bilstm,
-    "axis_nn": learned.axis_nn,
+    "bilstm": _bilstm,
+    "axis_nn": _axis_nn,
 }
 
 

@@ -19,6 +19,13 @@ decades (a 0.01 mm line at 200 mm/s takes a servo period or more, 20 times its n
 and a squared loss on :math:`s_k` itself is ruled by those few lines. The predicted cycle time
 is :math:`\sum_k e^{\widehat{\ln s_k}} l_k / F_k` (:func:`nctwin.methods.chien2023.block_times_s`);
 the per-axis networks give it by eq. 9-10 (:func:`nctwin.methods.sun2022.block_times_s`).
+
+A network can predict a move faster than any control runs it (on a 100 mm square at 20 mm/s,
+both give about 18 s for moves that take at least 20 s). For ``nctwin estimate`` (:func:`bilstm`,
+:func:`axis_nn`) every move's time is raised to its physical floor, its length over its feed
+within the machine's limits (:func:`move_floors_s`), and the :class:`Estimate` says how many
+were raised; the chapter's numbers (:func:`predict_bilstm`, :func:`predict_axis_nn`) are the
+networks' own.
 """
 
 from __future__ import annotations
@@ -57,6 +64,7 @@ __all__ = [
     "features",
     "model_blocks",
     "move_data",
+    "move_floors_s",
     "predict_axis_nn",
     "predict_bilstm",
     "recorded_move_data",
@@ -361,25 +369,46 @@ def trained_models(machine: MachineProfile, seed: int = 0) -> tuple[Trained, lis
     return train_bilstm(data, bilstm_cfg), train_axis_nns(data, axis_cfg)
 
 
-def _block_times(
-    tp: Toolpath, move_times_s: np.ndarray, method: str, machine: MachineProfile
+def move_floors_s(data: MoveData) -> np.ndarray:
+    """Physical floor of each move, its length over its feed within the machine's limits
+    (:func:`features`: the programmed feed, the rapid feed for rapids, clipped to the maximum
+    feed and to the axis velocities along the move, :func:`~nctwin.estimate.blend_planner.
+    move_limits`), shape (M,): no control runs a move faster."""
+    return data.features[:, 1] / data.features[:, 0]
+
+
+def _floored_estimate(
+    tp: Toolpath, data: MoveData, move_times_s: np.ndarray, method: str, machine: MachineProfile
 ) -> Estimate:
-    """Per-block :class:`~nctwin.estimate.result.Estimate` from per-move times (dwells keep
-    theirs)."""
+    """Per-block :class:`~nctwin.estimate.result.Estimate` from per-move predictions, each
+    raised to its physical floor (:func:`move_floors_s`); dwells keep their time."""
     _, source = model_blocks(tp)
-    t = np.bincount(source, weights=move_times_s, minlength=len(tp)) + tp.dwell_s
-    return Estimate(method, machine.name, t, tp)
+    floor = move_floors_s(data)
+    clamped = move_times_s < floor
+    t = np.where(clamped, floor, move_times_s)
+    blocks = np.bincount(source, weights=t, minlength=len(tp)) + tp.dwell_s
+    return Estimate(
+        method,
+        machine.name,
+        blocks,
+        tp,
+        floor_time_s=float(floor.sum()) + data.dwell_s,
+        clamped_moves=int(clamped.sum()),
+        unclamped_time_s=float(move_times_s.sum()) + data.dwell_s,
+    )
 
 
 def bilstm(tp: Toolpath, machine: MachineProfile) -> Estimate:
-    """``nctwin estimate --method bilstm``: the chapter's BiLSTM (LinuxCNC recordings only)."""
+    """``nctwin estimate --method bilstm``: the chapter's BiLSTM (LinuxCNC recordings only),
+    every move at least its physical floor (:func:`move_floors_s`)."""
     model, _ = trained_models(machine)
     data = move_data("program", tp, machine)
-    return _block_times(tp, bilstm_move_times(model, data), "bilstm", machine)
+    return _floored_estimate(tp, data, bilstm_move_times(model, data), "bilstm", machine)
 
 
 def axis_nn(tp: Toolpath, machine: MachineProfile) -> Estimate:
-    """``nctwin estimate --method axis_nn``: the chapter's per-axis networks (LinuxCNC only)."""
+    """``nctwin estimate --method axis_nn``: the chapter's per-axis networks (LinuxCNC only),
+    every move at least its physical floor (:func:`move_floors_s`)."""
     _, models = trained_models(machine)
     data = move_data("program", tp, machine)
-    return _block_times(tp, axis_nn_move_times(models, data), "axis_nn", machine)
+    return _floored_estimate(tp, data, axis_nn_move_times(models, data), "axis_nn", machine)

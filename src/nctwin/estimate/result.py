@@ -25,12 +25,23 @@ class Estimate:
         Time of each block of the tool path.
     toolpath : Toolpath
         The estimated tool path.
+    floor_time_s : float, optional
+        Physical floor of the program, for a method that can predict less than that (the
+        learned ones): every move's length over its programmed feed within the machine's
+        limits, plus the dwells; None for the others.
+    clamped_moves : int
+        Moves whose predicted time was below their floor and was raised to it.
+    unclamped_time_s : float, optional
+        Cycle time before the moves were raised to their floor (None without a floor).
     """
 
     method: str
     machine: str
     block_times_s: np.ndarray
     toolpath: Toolpath
+    floor_time_s: float | None = None
+    clamped_moves: int = 0
+    unclamped_time_s: float | None = None
 
     @property
     def cycle_time_s(self) -> float:
@@ -52,8 +63,12 @@ class Estimate:
         return out
 
     def summary(self) -> dict:
-        """Machine-readable summary (what ``nctwin estimate --json`` prints)."""
-        return {
+        """Machine-readable summary (what ``nctwin estimate --json`` prints).
+
+        With a floor, also ``clamped_to_floor`` (moves raised to their floor),
+        ``unclamped_cycle_time_s`` and ``floor_time_s``.
+        """
+        out = {
             "method": self.method,
             "machine": self.machine,
             "cycle_time_s": self.cycle_time_s,
@@ -61,3 +76,8 @@ class Estimate:
             "blocks": len(self.toolpath),
             "by_kind": self.by_kind(),
         }
+        if self.floor_time_s is not None:
+            out["clamped_to_floor"] = self.clamped_moves
+            out["unclamped_cycle_time_s"] = self.unclamped_time_s
+            out["floor_time_s"] = self.floor_time_s
+        return out

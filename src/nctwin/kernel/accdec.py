@@ -1,9 +1,11 @@
-r"""A Fanuc-like control: interpolation first, acc/dec after it, block overlap, in-position.
+r"""The ideal block-overlap control: interpolation first, linear acc/dec after it, in-position.
 
-This is the "measured" machine of the chapter on Lee et al. 2022 (J. Korean Soc. Precis. Eng.
-39(7), 537-543). It simulates, sample by sample at the interpolation period :math:`T_I`, what
-the paper's analytic estimator (:mod:`nctwin.estimate.block_overlap`) only calculates, and it
-has effects the estimator lacks.
+This is the machine the analytic estimator of Lee et al. 2022 (J. Korean Soc. Precis. Eng.
+39(7), 537-543; :mod:`nctwin.methods.lee2022`) was derived for: it simulates, sample by sample
+at the interpolation period :math:`T_I`, the algorithm behind the paper's eq. 1-16, so the
+estimator is exact on it up to rounding and the in-position waits. The chapter uses it only as
+its sanity row ("ideal machine"); its measured machine is :mod:`nctwin.kernel.fanuc`, which has
+the effects this kernel lacks (block-processing time, arc clamp, other acc/dec shapes).
 
 What is simulated
 -----------------
@@ -32,7 +34,8 @@ Rapids (G0)
     own travel (eq. 7, 12). A second moving average of length :math:`A_s` (``rapid_bell_s``)
     gives the bell (S-curve) shape (eq. 13-16).
 Position loop and in-position check
-    Each axis follows its command through a first-order position loop,
+    Each axis follows its command through the package's position loop
+    (:class:`nctwin.physics.servo.PositionLoop`, first order without feed-forward),
     :math:`\dot e = v_\mathrm{cmd} - K_p e`, discretised exactly for ZOH input. After every
     rapid the next block waits until the following error :math:`|e|` of *every* axis is within
     its in-position width. The wait depends on the rapid's deceleration, the gain and the
@@ -60,6 +63,7 @@ from scipy.signal import lfilter
 
 from ..machine import MachineProfile, whole_periods
 from ..motion import Motion
+from ..physics.servo import PositionLoop
 from ..toolpath import PLANE_AXES, MotionKind, Toolpath
 
 __all__ = ["AccDecRun", "InPositionMeasurement", "measure_inposition_times", "run", "simulate"]
@@ -283,10 +287,13 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
             f"feed_mm_s = {float(toolpath.feed_mm_s[j])!r} of block {j} "
             f"(line {toolpath.line[j]}) is out of range: a cutting block needs a feed F > 0"
         )
-    kp = np.asarray(machine.position_gain_per_s)
     width = np.asarray(machine.inposition_width_mm)
-    r = np.exp(-kp * ti)
-    g = (1.0 - r) / (kp * ti)  # error gain per mm of commanded displacement in a period
+    # each axis's position loop, exact for a velocity held over a period: e <- r e + g d, with
+    # r = exp(-Kp TI) and g = bd / TI per mm of commanded displacement d in the period
+    loops = [PositionLoop("first_order_ff", kp) for kp in machine.position_gain_per_s]
+    ad, bd = zip(*(loop.matrices(ti) for loop in loops), strict=True)
+    r = np.array([a[0, 0] for a in ad])
+    g = np.array([b[0] for b in bd]) / ti
 
     n_blocks = len(toolpath)
     geo = _Geometry(toolpath)
@@ -317,7 +324,7 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
         if k0 == MotionKind.RAPID:
             cmd_end[first] = n_periods * ti
             ratio = np.abs(e) / width
-            need = np.where(ratio > 1.0, np.log(np.maximum(ratio, 1.0)) / (kp * ti), 0.0)
+            need = np.where(ratio > 1.0, np.log(np.maximum(ratio, 1.0)) / -np.log(r), 0.0)
             w = int(np.ceil(need.max() - 1e-9)) if need.max() > 0 else 0
             if w:
                 decay = r[None, :] ** np.arange(1, w + 1)[:, None]

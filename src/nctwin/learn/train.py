@@ -40,7 +40,8 @@ import copy
 import math
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -58,6 +59,7 @@ __all__ = [
     "TrainingDivergedError",
     "fit",
     "load_checkpoint",
+    "one_thread",
 ]
 
 
@@ -208,12 +210,14 @@ class Trained:
     def predict(self, x: np.ndarray) -> np.ndarray:
         """Outputs for one program, shape (N, n_outputs), from inputs (N, n_inputs).
 
-        Runs overlapping windows of ``window_lines`` in one batch and keeps the middle half of
-        each (see the module docstring)."""
+        A sequence model runs overlapping windows of ``window_lines`` in one batch and keeps the
+        middle half of each (see the module docstring); a per-row network (an MLP, the BP
+        network) runs all rows in one pass."""
         z = torch.from_numpy(self.x_scaler.transform(x))
         n, w = len(z), self.train_config.window_lines
-        with torch.no_grad():
-            if n <= w or isinstance(self.model, BPNetwork):  # one row at a time: no windows
+        with torch.no_grad(), one_thread():
+            per_row = isinstance(self.model, BPNetwork) or self.model.config.kind == "mlp"
+            if n <= w or per_row:  # no windows
                 out = self.model(z[None])[0].numpy()
             else:
                 core = max(w // 2, 1)
@@ -226,6 +230,23 @@ class Trained:
                     b = min(ai + core, n)
                     out[ai:b] = y[i, ai - si : b - si]
         return self.y_scaler.inverse(out)
+
+
+@contextmanager
+def one_thread() -> Iterator[None]:
+    """Run torch on one intra-op thread, and restore the count after.
+
+    Training and prediction both do: the summation order, hence the rounding, of a reduction
+    depends on the thread count, and on a loaded machine two threads of a small network wait for
+    each other (a prediction took 2 s with two threads and 0.1 s with one under a load average of
+    12 on two cores).
+    """
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(threads)
 
 
 def data_hash(xs: Sequence[np.ndarray], ys: Sequence[np.ndarray]) -> str:
@@ -332,9 +353,7 @@ def fit(
     if cache and path.exists():
         return load_checkpoint(path)
 
-    threads = torch.get_num_threads()
     deterministic = torch.are_deterministic_algorithms_enabled()
-    torch.set_num_threads(1)
     torch.use_deterministic_algorithms(True)
     try:
         if validation is not None:  # the given programs validate, all others train
@@ -347,9 +366,9 @@ def fit(
         # training repeats bit for bit and the caller's random state is left as it was
         with torch.random.fork_rng(devices=[]):
             torch.manual_seed(train_config.seed)
-            trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
+            with one_thread():
+                trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     finally:
-        torch.set_num_threads(threads)
         torch.use_deterministic_algorithms(deterministic)
     if cache:
         save_checkpoint(trained)

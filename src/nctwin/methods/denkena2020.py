@@ -38,7 +38,7 @@ from scipy import signal
 from scipy.optimize import least_squares
 
 from ..learn.models import ModelConfig
-from ..learn.train import Trained
+from ..learn.train import Trained, one_thread
 
 __all__ = [
     "INPUT_NAMES",
@@ -370,11 +370,14 @@ def lstm_inputs(scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:
 
 
 def predict(nets: dict[str, Trained], scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:
-    """LSTM forces (R, 3) of one process."""
+    """LSTM forces (R, 3) of one process; NaN in the columns of axes without a network."""
     x = scaling.inputs(inputs)
-    return np.stack(
-        [scaling.force_inverse(nets[a].predict(x)[:, 0], i) for i, a in enumerate("XYZ")], axis=1
-    )
+    out = np.full((len(x), 3), np.nan)
+    with one_thread():
+        for a, net in nets.items():
+            i = "XYZ".index(a)
+            out[:, i] = scaling.force_inverse(net.predict(x)[:, 0], i)
+    return out
 
 
 def mc_dropout(
@@ -397,7 +400,7 @@ def mc_dropout(
         model = nets[a].model
         model.train()
         try:
-            with torch.random.fork_rng(devices=[]):
+            with one_thread(), torch.random.fork_rng(devices=[]):
                 torch.manual_seed(seed)
                 for k in range(samples):
                     out[k, :, j] = scaling.force_inverse(nets[a].predict(x)[:, 0], i)

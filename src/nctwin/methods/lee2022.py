@@ -50,9 +50,9 @@ import math
 import numpy as np
 
 from ..machine import MachineProfile, whole_periods
-from ..toolpath import MotionKind, Toolpath
+from ..toolpath import MotionKind, PathMode, Toolpath
 
-__all__ = ["block_times", "overlapped_block_times"]
+__all__ = ["block_times", "check_program", "overlapped_block_times"]
 
 _CUT = (MotionKind.LINEAR, MotionKind.ARC_CW, MotionKind.ARC_CCW)
 
@@ -60,6 +60,39 @@ _CUT = (MotionKind.LINEAR, MotionKind.ARC_CW, MotionKind.ARC_CCW)
 def _ceil_ti(t_s: np.ndarray, period_s: float) -> np.ndarray:
     """:math:`\\lceil t \\rceil_{T_I}` (eq. 2), forgiving 1e-9 period of round-off."""
     return np.ceil(np.asarray(t_s, dtype=float) / period_s - 1e-9) * period_s
+
+
+def check_program(toolpath: Toolpath, source: str = "<program>") -> None:
+    """Refuse a program with a construct the method cannot model.
+
+    The paper's parser reads G00, G01, G02/G03 and G04 (Sec. 2.4), and its cycle-time
+    calculator knows two ways a block may end: overlapped into the next cutting block, or
+    stopped before a rapid or a dwell (Sec. 2.2). An exact-stop mode (``G61``, ``G61.1``) stops
+    cutting blocks the method would overlap, and a blending tolerance (``G64 P``) is a
+    path-blending rule of another kind of control; both would be priced wrongly, so they are
+    refused.
+
+    Parameters
+    ----------
+    toolpath : Toolpath
+        N blocks, with their source lines.
+    source : str
+        The program's file name, for the message.
+
+    Raises
+    ------
+    ValueError
+        ``"<source>:<line>: <reason>"`` for the first such block.
+    """
+    exact = toolpath.path_mode >= PathMode.EXACT_PATH
+    tol = (toolpath.path_mode == PathMode.BLEND) & np.isfinite(toolpath.blend_tol_mm)
+    for bad, reason in (
+        (exact, "exact-stop mode (G61/G61.1): the block-overlap method has no exact stop"),
+        (tol, "G64 P blending tolerance: the block-overlap method has no path tolerance"),
+    ):
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{source}:{toolpath.line[k]}: {reason}")
 
 
 def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.ndarray]:

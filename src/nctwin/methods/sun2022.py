@@ -110,7 +110,8 @@ def block_times_s(
     axis_feed_mm_s: np.ndarray, length_mm: np.ndarray, commanded_mm_s: np.ndarray
 ) -> np.ndarray:
     r"""Time of each block, :math:`t_n = l_n / \lVert f_n \rVert` (eq. 10; the machining time is
-    their sum), with the resultant feed of :func:`resultant_feed_mm_s`.
+    their sum, over every block, rapids included, as the paper's sum runs over every cutter
+    location), with the resultant feed of :func:`resultant_feed_mm_s`.
 
     Parameters
     ----------

@@ -2,7 +2,8 @@
 data sampled slowly and unevenly.
 
 A real control records its axes' actual positions, which lag its command: :class:`Recording`
-adds a first-order position loop (servo lag, with the wait for the in-position window at the end)
+adds the package's position loop (:class:`~nctwin.physics.servo.PositionLoop`, first order, no
+feed-forward) (servo lag, with the wait for the in-position window at the end)
 and encoder noise to a kernel's command positions (Chien et al. 2023, "machine B").
 
 Sun et al. (2022, Sec. 4.1) read the actual axis feeds of a Siemens 840D at about 5 Hz: 901
@@ -17,9 +18,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ..motion import Motion
+from .servo import PositionLoop
 
 __all__ = ["ControllerSamples", "Recording", "controller_samples", "nearest_sample"]
 
@@ -77,6 +78,7 @@ def nearest_sample(
     passage_s: np.ndarray,
     *,
     window_s: float = 2.0,
+    since_s: np.ndarray | None = None,
 ) -> np.ndarray:
     """For each point, the record nearest to it in space among the records within ``window_s``
     of the time the tool passed it (so that a later pass over the same spot is not taken).
@@ -90,6 +92,10 @@ def nearest_sample(
         Time the tool passes each cutter location (e.g. its junction sample's time).
     window_s : float
         Half-width of the time window searched.
+    since_s : ndarray, shape (N,), optional
+        Where given (finite), only the records taken from ``since_s`` to ``passage_s`` count,
+        e.g. those taken while the tool was on the block that ends at the point; a point with
+        no such record within the window keeps the nearest of all. NaN: no restriction.
 
     Returns
     -------
@@ -101,7 +107,12 @@ def nearest_sample(
     centre = np.searchsorted(samples.t_s, passage_s)
     cand = np.clip(centre[:, None] + np.arange(-span, span + 1)[None, :], 0, m - 1)
     d2 = ((samples.pos_mm[cand] - points_mm[:, None, :]) ** 2).sum(axis=2)
-    d2[np.abs(samples.t_s[cand] - passage_s[:, None]) > window_s] = np.inf
+    t = samples.t_s[cand]
+    d2[np.abs(t - passage_s[:, None]) > window_s] = np.inf
+    if since_s is not None:
+        outside = (t < since_s[:, None]) | (t > passage_s[:, None])
+        restrict = np.isfinite(since_s) & (np.isfinite(d2) & ~outside).any(axis=1)
+        d2[restrict[:, None] & outside] = np.inf
     return cand[np.arange(len(points_mm)), np.argmin(d2, axis=1)]
 
 
@@ -112,7 +123,9 @@ class Recording:
     Parameters
     ----------
     position_gain_1_s : float
-        Gain ``Kv`` of a first-order position loop per axis (1/s); the actual position lags the
+        Gain ``Kv`` of a first-order position loop per axis (1/s,
+        :class:`~nctwin.physics.servo.PositionLoop` ``first_order_ff`` without feed-forward,
+        discretised exactly); the actual position lags the
         command by ``F / Kv``, in time by ``1 / Kv``, and so do the recorded block labels. 0: no
         lag (the simulation profile).
     in_position_mm : float
@@ -135,17 +148,15 @@ class Recording:
         pos = motion.pos_mm
         block = motion.block
         if self.position_gain_1_s > 0:
-            a = 1.0 - np.exp(-self.position_gain_1_s * ts)
-            # settle: the lag decays by (1 - a) per sample from at most the largest lag
-            lag_mm = np.abs(pos - np.roll(pos, 1, axis=0))[1:].max(initial=0.0) / a
-            extra = int(np.ceil(np.log(self.in_position_mm / max(lag_mm, 1e-12)) / np.log(1 - a)))
-            extra = max(extra, 0)
+            loop = PositionLoop("first_order_ff", gain_per_s=self.position_gain_1_s)
+            # settle: the following error decays as exp(-Kv t) from at most the largest lag
+            lag_mm = np.abs(np.diff(pos, axis=0)).max(initial=0.0) / (ts * self.position_gain_1_s)
+            ratio = self.in_position_mm / max(lag_mm, 1e-12)
+            extra = max(int(np.ceil(-np.log(ratio) / (self.position_gain_1_s * ts))), 0)
             cmd = np.vstack([pos, np.repeat(pos[-1:], extra, axis=0)])
-            # y[n] = (1 - a) y[n-1] + a x[n-1], at rest on the first command position
-            pos = np.column_stack(
-                [lfilter([0.0, a], [1.0, a - 1.0], cmd[:, i], zi=cmd[:1, i])[0] for i in range(3)]
-            )
-            delay = round(1.0 / a)  # the loop's following time in samples (1 / Kv as ts -> 0)
+            # an axis the program does not move stays where it is (follow() would return it)
+            pos = np.column_stack([c if np.all(c == c[0]) else loop.follow(c, ts) for c in cmd.T])
+            delay = round(1.0 / (self.position_gain_1_s * ts))  # following time 1 / Kv
             block = np.concatenate([np.full(delay, block[0]), block, np.full(extra, block[-1])])
             block = block[: len(pos)]
         if self.noise_mm > 0:

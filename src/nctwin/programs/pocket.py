@@ -24,17 +24,35 @@ contour-parallel offsets:
   them (stay-down linking), so the program is one chain of feed moves at one depth.
 * **Arcs** (fillets, the arcs of the island's offsets) are written as chords within
   ``chord_tol_mm`` of the arc, as a CAM post-processor that outputs only G1 does.
+* **Corner zones** (:func:`paper_pocket_program` only): the sharp corners of every offset are
+  rounded by an arc of ``corner_radius_mm``, as CAM systems smooth the corners of their offsets,
+  so each becomes a few short chords between two long lines that meet them tangentially.
+
+:func:`paper_pocket_program` scales this part to the pockets of Chien et al. (2023) Tables 2
+and 3 (:data:`PAPER_POCKETS`), each setting fixed by one statistic the paper publishes;
+:func:`pocket_stats` gives the statistics of a path.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from ..checks import check_range
 
-__all__ = ["BAND_MM", "OUTLINE_MM", "pocket_program", "pocket_rings"]
+__all__ = [
+    "BAND_MM",
+    "OUTLINE_MM",
+    "PAPER_POCKETS",
+    "PaperPocket",
+    "paper_pocket_program",
+    "paper_pocket_rings",
+    "pocket_program",
+    "pocket_rings",
+    "pocket_stats",
+]
 
 #: Outline of the pocket's wall, counter-clockwise: vertices (mm) and the fillet radius of each
 #: corner (0: sharp). A 5 mm fillet bottom-left, a sharp corner bottom-right, a chamfer of two
@@ -57,6 +75,14 @@ OUTLINE_MM = (
 #: Width of the floor between the outline and the island (mm); the island is the outline offset
 #: inward by this distance (its corners sharp where the outline's fillet is smaller).
 BAND_MM = 42.0
+#: Scale of the Table 2 pocket: its path is 12.40 m, the mean of the 11.5-13.1 m that Table 2's
+#: CAM times imply.
+SCALE_TABLE2 = 1.076
+#: Scale of the Table 3 pocket: 4.60 m, the path nearest 4.4 m that the offsets' steps allow
+#: (a scale of 0.666 gives 4.18 m).
+SCALE_TABLE3 = 0.668
+#: Chordal tolerance of the paper's pockets: 4993 G-lines in the Table 2 pocket (paper: 5000).
+CHORD_TOL_PAPER_MM = 0.00145
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -88,14 +114,21 @@ def _ring(
     start: np.ndarray,
     chord_tol: float,
     excursions: dict[int, list[np.ndarray]] | None = None,
+    corner_radius: float = 0.0,
 ) -> np.ndarray:
     """Points of a closed counter-clockwise ring, from ``start`` (a point on edge 0 -> 1) around
     and back: straight edges as one segment, fillets as chords within ``chord_tol``. At a sharp
     vertex ``i`` of ``excursions``, the tool cuts those loops (each from and back to its first
-    point) and returns to the vertex.
+    point) and returns to the vertex. Every other sharp vertex is rounded with an arc of radius
+    ``corner_radius`` (0: left sharp).
 
     Raises ValueError where a fillet does not fit on its edges (the offset has collapsed)."""
     m = len(vertices)
+    if corner_radius > 0:
+        rounded = radii == 0
+        if excursions:
+            rounded[[i for i, loops in excursions.items() if loops]] = False
+        radii = np.where(rounded, corner_radius, radii)
     u = _unit(np.roll(vertices, -1, axis=0) - vertices)
     u_in = np.roll(u, 1, axis=0)
     turn = np.arctan2(u_in[:, 0] * u[:, 1] - u_in[:, 1] * u[:, 0], (u_in * u).sum(axis=1))
@@ -148,23 +181,32 @@ def _corner_loop(
 
 
 def pocket_rings(
-    *, tool_radius_mm: float = 4.0, stepover_mm: float = 2.0, chord_tol_mm: float = 0.001
+    *,
+    tool_radius_mm: float = 4.0,
+    stepover_mm: float = 2.0,
+    chord_tol_mm: float = 0.001,
+    outline_scale: float = 1.0,
+    corner_radius_mm: float = 0.0,
 ) -> list[np.ndarray]:
     """The tool-centre path of the pocket as closed polylines in cutting order (island and
     outline ring per level, middle out; the first outline ring with the corner loops), each
     shape (n_i, 2).
 
-    See the module docstring; the parameters are those of :func:`pocket_program`.
+    See the module docstring; the parameters are those of :func:`pocket_program`, and
+    ``outline_scale`` (the outline, its fillets and the band scaled about the origin) and
+    ``corner_radius_mm`` (every sharp corner of a ring rounded with an arc of this radius, as a
+    CAM system smooths the corners of its offsets; 0: sharp) those of :func:`paper_pocket_program`.
     """
-    verts = np.array([p for p, _ in OUTLINE_MM])
-    radii = np.array([r for _, r in OUTLINE_MM])
-    island = _offset(verts, radii, BAND_MM)
-    width = BAND_MM - 2 * tool_radius_mm
+    verts = outline_scale * np.array([p for p, _ in OUTLINE_MM])
+    radii = outline_scale * np.array([r for _, r in OUTLINE_MM])
+    band = outline_scale * BAND_MM
+    island = _offset(verts, radii, band)
+    width = band - 2 * tool_radius_mm
     n_levels = math.ceil(width / stepover_mm) + 1  # positions across the band, walls included
     step = width / (n_levels - 1)
     levels = tool_radius_mm + step * np.arange((n_levels + 1) // 2)[::-1]  # middle first
     x_start = 0.4 * verts[1, 0]
-    half = 0.5 * BAND_MM
+    half = 0.5 * band
     # corner loops beyond the middle, in the outline's corners where the island's is sharp
     corners = np.flatnonzero(island[1] == 0)
     loops: dict[int, list[np.ndarray]] = {int(i): [] for i in corners}
@@ -184,10 +226,11 @@ def pocket_rings(
     for k, d in enumerate(levels):
         if d < half - 0.25 * step:  # the middle level is cut once, by the outline's ring
             poly = _offset(*island, -d)
-            rings.append(_ring(*poly, np.array([x_start, poly[0][0, 1]]), chord_tol_mm)[::-1])
+            start = np.array([x_start, poly[0][0, 1]])
+            rings.append(_ring(*poly, start, chord_tol_mm, None, corner_radius_mm)[::-1])
         poly = _offset(verts, radii, d)
         start = np.array([x_start, poly[0][0, 1]])
-        rings.append(_ring(*poly, start, chord_tol_mm, loops if k == 0 else None))
+        rings.append(_ring(*poly, start, chord_tol_mm, loops if k == 0 else None, corner_radius_mm))
     return rings
 
 
@@ -228,9 +271,18 @@ def pocket_program(
     check_range("chord_tol_mm", chord_tol_mm, 0.0, 0.1 * tool_radius_mm, low_open=True)
     if tol_mm is not None:
         check_range("tol_mm", tol_mm, 0.0, math.inf, low_open=True)
-    path = np.round(np.vstack(pocket_rings(tool_radius_mm=tool_radius_mm,
-                                           stepover_mm=stepover_mm, chord_tol_mm=chord_tol_mm)),
-                    4)  # fmt: skip
+    path = np.vstack(
+        pocket_rings(
+            tool_radius_mm=tool_radius_mm, stepover_mm=stepover_mm, chord_tol_mm=chord_tol_mm
+        )
+    )
+    return _program_text(path, feed_mm_s, tol_mm)
+
+
+def _program_text(path_mm: np.ndarray, feed_mm_s: float, tol_mm: float | None) -> str:
+    """G-code of a tool-centre path, shape (n, 2): rounded to 0.1 um, repeated points dropped,
+    a plunge at its first point, then one G1 per point."""
+    path = np.round(path_mm, 4)
     keep = np.append(True, (np.diff(path, axis=0) != 0).any(axis=1))
     path = path[keep]
     lines = ["(nctwin pocket: contour-parallel offsets around an island, middle out)",
@@ -246,3 +298,89 @@ def pocket_program(
     lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in path[1:]]
     lines += ["G0 Z5", "M30"]
     return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True)
+class PaperPocket:
+    r"""The CAM settings of one of the paper's pockets, each fixed by one published statistic.
+
+    Parameters
+    ----------
+    outline_scale : float
+        Scale of :data:`OUTLINE_MM` and :data:`BAND_MM`: fixed by the path length the paper's
+        CAM times imply (:math:`\sum l_k = T_\mathrm{CAM} F`).
+    chord_tol_mm : float
+        Chordal tolerance of the arcs: fixed by the number of G-lines.
+    corner_radius_mm : float
+        Radius that rounds the sharp corners of the offsets (the corner zones): 10 % of the tool
+        diameter, a CAM system's usual corner smoothing.
+    tool_radius_mm, stepover_mm : float
+        The 8 mm end mill and the 2 mm stepover of :func:`pocket_program`.
+    """
+
+    outline_scale: float
+    chord_tol_mm: float
+    corner_radius_mm: float = 0.8
+    tool_radius_mm: float = 4.0
+    stepover_mm: float = 2.0
+
+
+#: The pockets of Tables 2 and 3. Table 2: CAM times 125-174 s at 75 and 92 mm/s imply
+#: 11.5-13.1 m of path (mean 12.4 m) and the text gives 5000 G-lines. Table 3: 55-63 s at 70 and
+#: 80 mm/s imply 4.3-4.5 m (mean 4.4 m); the same CAM settings, a smaller part. The scales and
+#: the chordal tolerance were solved for those statistics (:func:`pocket_stats`) and frozen.
+PAPER_POCKETS = {
+    "table2": PaperPocket(outline_scale=SCALE_TABLE2, chord_tol_mm=CHORD_TOL_PAPER_MM),
+    "table3": PaperPocket(outline_scale=SCALE_TABLE3, chord_tol_mm=CHORD_TOL_PAPER_MM),
+}
+
+
+def paper_pocket_rings(name: str) -> list[np.ndarray]:
+    """The tool-centre rings of :data:`PAPER_POCKETS` ``[name]`` (see :func:`pocket_rings`)."""
+    if name not in PAPER_POCKETS:
+        raise ValueError(f"name = {name!r} is unknown: allowed {', '.join(PAPER_POCKETS)}")
+    return pocket_rings(**asdict(PAPER_POCKETS[name]))
+
+
+def paper_pocket_program(name: str, *, feed_mm_s: float, tol_mm: float | None = None) -> str:
+    """G-code of the pocket of Chien et al. (2023) Table 2 (``"table2"``) or Table 3
+    (``"table3"``): :func:`pocket_program`'s part at the scale of :data:`PAPER_POCKETS`, its
+    offsets' sharp corners rounded by short chords.
+
+    Parameters
+    ----------
+    name : {"table2", "table3"}
+    feed_mm_s : float
+        Programmed feed, in (0, 1000].
+    tol_mm : float, optional
+        A ``G64 P`` blending tolerance; none: the machine's.
+
+    Returns
+    -------
+    str
+    """
+    check_range("feed_mm_s", feed_mm_s, 0.0, 1000.0, low_open=True)
+    if tol_mm is not None:
+        check_range("tol_mm", tol_mm, 0.0, math.inf, low_open=True)
+    return _program_text(np.vstack(paper_pocket_rings(name)), feed_mm_s, tol_mm)
+
+
+def pocket_stats(path_mm: np.ndarray, *, short_mm: float = 1.0) -> dict[str, float]:
+    """Statistics of a tool-centre path, shape (n, 2), as :func:`_program_text` writes it.
+
+    Returns
+    -------
+    dict
+        ``lines`` (G1 moves), ``path_m``, the segment-length quantiles ``seg_p10_mm``,
+        ``seg_p50_mm``, ``seg_p90_mm``, ``seg_max_mm``, the share of G-lines shorter than
+        ``short_mm`` (``short_share_pct``) and of the path on them (``short_length_pct``).
+    """
+    path = np.round(path_mm, 4)
+    seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    seg = seg[seg > 0]
+    short = seg < short_mm
+    p10, p50, p90 = np.percentile(seg, [10, 50, 90])
+    return {"lines": len(seg), "path_m": seg.sum() / 1000.0, "seg_p10_mm": p10,
+            "seg_p50_mm": p50, "seg_p90_mm": p90, "seg_max_mm": seg.max(),
+            "short_share_pct": 100.0 * short.mean(),
+            "short_length_pct": 100.0 * seg[short].sum() / seg.sum()}  # fmt: skip

@@ -1,15 +1,19 @@
 """The thin-wall aerospace part of Sun et al. (2022, Fig. 7-8): eight pockets, roughed with
 high-performance toolpaths.
 
-Each pocket is a separate program: a plunge, contour-parallel offsets cut from the inside out in
-two depth levels (or trochoidal loops in a slot), short G1 links between offsets, and G0 retracts
-and repositioning moves between levels and regions. Feeds are 3000-4000 mm/min, rapids G0. The
-shapes differ in size and topology: rectangular, rounded, a circular boss, an L, a slot, islands
-and two separate regions.
+Each pocket is a separate program with one roughing strategy, the same on every pocket: per depth
+level a plunge, trochoidal loops of one radius (:data:`TROCHOID_RADIUS_MM`) along the middle, then
+contour-parallel offsets cut from the inside out, joined by short G1 links; G0 retracts and
+repositioning moves between levels and regions. Feeds are 3000-4000 mm/min, rapids G0. The shapes
+differ in size and topology: rectangular, rounded, a circular boss, an L, a slot, and two separate
+regions.
 
-The rapids are laid out as in the paper's Fig. 13: the programs start at the tool-change position
-to the right of the part, so pocket 1 has only rapids in -X (and in Y and Z); pocket 8 has two
-regions cut left to right, so it also has a rapid in +X.
+Curves and straight moves are written as G1 chords of about :data:`SEGMENT_MM` (the paper's
+pocket 1 has 5383 cutter locations over a roughing path of some 16 m). Each program starts above
+its first entry point at the clearance plane, as a CAM post writes it after the tool change (no
+rapid from a remote position), and rapids down to 1 mm above the floor of the level before
+feeding in. Pocket 1 therefore has rapids towards -X only (back to the start of each level), and
+pocket 8, whose two regions are cut left to right, also one towards +X (the paper's Fig. 13).
 """
 
 from __future__ import annotations
@@ -19,16 +23,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["HOME_MM", "POCKETS", "PocketSpec", "pocket_program", "thinwall_programs"]
+__all__ = [
+    "POCKETS",
+    "SEGMENT_MM",
+    "TROCHOID_RADIUS_MM",
+    "PocketSpec",
+    "pocket_program",
+    "start_mm",
+    "thinwall_programs",
+]
 
-#: Tool-change position the programs start from (mm): right of, behind and above the part.
-HOME_MM = (620.0, 260.0, 60.0)
+#: Clearance plane (mm above the part's top face, Z0) the programs start at and retract to.
+CLEARANCE_Z_MM = 5.0
 
-_SAFE_Z = 5.0
+#: Depth of one level (mm).
+LEVEL_DEPTH_MM = 3.0
 
-#: Longest G1 segment: CAM systems output adaptive (HPC) roughing paths as dense point
-#: sequences; the paper's pocket 1 has 5383 cutter locations over about 18 m (3.4 mm each).
-MAX_SEGMENT_MM = 3.0
+#: Chord length of the G1 moves (mm): CAM output of high-performance roughing is a dense point
+#: sequence; the paper's pocket 1 has 5383 cutter locations over some 16 m (about 3 mm each).
+SEGMENT_MM = 3.0
 
 #: Smallest corner radius of the offsets: HPC toolpaths round every corner (mm).
 MIN_CORNER_MM = 3.0
@@ -44,7 +57,7 @@ class PocketSpec:
         Pocket number (1-8).
     shape : str
         ``"rect"``, ``"rounded"``, ``"boss"`` (rectangle around a circular island), ``"L"``,
-        ``"slot"`` (trochoidal) or ``"twin"`` (two regions left and right of a rib).
+        ``"slot"`` (long and narrow) or ``"twin"`` (two regions left and right of a rib).
     center_mm : tuple of 2 floats
         Centre of the pocket on the part.
     size_mm : tuple of 2 floats
@@ -54,7 +67,7 @@ class PocketSpec:
     feed_mm_min : float
         Cutting feed.
     depth_levels : int
-        Depth levels of 3 mm.
+        Depth levels of :data:`LEVEL_DEPTH_MM`.
     """
 
     number: int
@@ -68,14 +81,14 @@ class PocketSpec:
 
 #: The eight pockets (4 x 2 on a 560 x 240 mm part).
 POCKETS = (
-    PocketSpec(1, "rect", (70.0, 60.0), (110.0, 90.0), 0.0, 3500.0, 3),
-    PocketSpec(2, "rounded", (200.0, 60.0), (70.0, 50.0), 12.0, 3000.0),
-    PocketSpec(3, "boss", (330.0, 60.0), (100.0, 80.0), 8.0, 3500.0),
-    PocketSpec(4, "L", (470.0, 60.0), (120.0, 100.0), 0.0, 4000.0, 3),
-    PocketSpec(5, "slot", (100.0, 180.0), (150.0, 30.0), 0.0, 3500.0, 3),
+    PocketSpec(1, "rect", (70.0, 60.0), (110.0, 90.0), 0.0, 3500.0, 4),
+    PocketSpec(2, "rounded", (200.0, 60.0), (66.0, 48.0), 12.0, 3000.0),
+    PocketSpec(3, "boss", (330.0, 60.0), (96.0, 76.0), 8.0, 3500.0, 3),
+    PocketSpec(4, "L", (470.0, 60.0), (114.0, 96.0), 0.0, 4000.0, 3),
+    PocketSpec(5, "slot", (100.0, 180.0), (165.0, 40.0), 0.0, 3500.0, 3),
     PocketSpec(6, "rounded", (250.0, 180.0), (90.0, 60.0), 25.0, 3000.0),
-    PocketSpec(7, "L", (380.0, 180.0), (100.0, 80.0), 6.0, 3500.0, 3),
-    PocketSpec(8, "twin", (500.0, 180.0), (110.0, 70.0), 4.0, 4000.0, 3),
+    PocketSpec(7, "L", (380.0, 180.0), (86.0, 70.0), 6.0, 3500.0, 3),
+    PocketSpec(8, "twin", (500.0, 180.0), (106.0, 68.0), 4.0, 4000.0, 3),
 )
 
 
@@ -175,97 +188,87 @@ def _trochoid(
     return np.column_stack([x, y + loop_radius * np.sin(phi)])
 
 
+#: Radius of the trochoidal loops, the same on every pocket (one roughing strategy), and their
+#: advance per loop (mm).
+TROCHOID_RADIUS_MM = 6.0
+TROCHOID_ADVANCE_MM = 2.0
+
+
 def _region(spec: PocketSpec, stepover: float, seg_mm: float) -> list[np.ndarray]:
-    """What one depth level cuts: a trochoidal slot along the middle (left to right), then the
-    contour-parallel offsets; a slot pocket is only the trochoid, a boss only rings and offsets."""
+    """What one depth level cuts: trochoidal loops along the middle (left to right), then the
+    contour-parallel offsets; a boss has no loops (rings around its island instead)."""
     cx, cy = spec.center_mm
-    w, h = spec.size_mm
-    if spec.shape == "slot":
-        r = 0.3 * h
-        return [
-            _trochoid(
-                cx - 0.5 * w + r,
-                cx + 0.5 * w - 3 * r,
-                cy,
-                r,
-                TROCHOID_ADVANCE_MM,
-                TROCHOID_SEGMENT_MM,
-            )
-        ]
+    w = spec.size_mm[0]
+    r = TROCHOID_RADIUS_MM
     path = _offsets(spec, stepover, seg_mm)
     if spec.shape != "boss":
         half = 0.3 * w
-        path.insert(
-            0,
-            _trochoid(
-                cx - half, cx + half, cy, 1.2 * stepover, TROCHOID_ADVANCE_MM, TROCHOID_SEGMENT_MM
-            ),
-        )
+        path.insert(0, _trochoid(cx - half, cx + half, cy, r, TROCHOID_ADVANCE_MM, seg_mm))
     return path
 
 
-#: Advance per loop and segment length of the trochoidal slots (mm).
-TROCHOID_ADVANCE_MM = 1.5
-TROCHOID_SEGMENT_MM = 1.0
+def _regions(spec: PocketSpec, stepover_mm: float, segment_mm: float) -> list[list[np.ndarray]]:
+    """The regions of a pocket in cutting order (two either side of a rib for ``"twin"``)."""
+    if spec.shape != "twin":
+        return [_region(spec, stepover_mm, segment_mm)]
+    cx, cy = spec.center_mm
+    w, h = spec.size_mm
+    return [
+        _region(
+            PocketSpec(0, "rounded", (cx + side * 0.275 * w, cy), (0.45 * w, h),
+                       spec.corner_radius_mm, spec.feed_mm_min),
+            stepover_mm,
+            segment_mm,
+        )
+        for side in (-1.0, 1.0)
+    ]  # fmt: skip
 
 
-def pocket_program(spec: PocketSpec, *, stepover_mm: float = 4.0, segment_mm: float = 0.5) -> str:
-    """G-code of one pocket, in mm, absolute, starting at :data:`HOME_MM`.
+def start_mm(spec: PocketSpec, *, stepover_mm: float = 4.0) -> tuple[float, float, float]:
+    """Where the program of ``spec`` starts: above its first entry point, at the clearance plane."""
+    x0, y0 = _regions(spec, stepover_mm, SEGMENT_MM)[0][0][0]
+    return (float(x0), float(y0), CLEARANCE_Z_MM)
+
+
+def pocket_program(
+    spec: PocketSpec, *, stepover_mm: float = 4.0, segment_mm: float = SEGMENT_MM
+) -> str:
+    """G-code of one pocket, in mm, absolute, starting at :func:`start_mm`.
 
     Parameters
     ----------
     spec : PocketSpec
     stepover_mm : float
-        Distance between contour-parallel offsets.
+        Distance between contour-parallel offsets, > 0.
     segment_mm : float
-        Length of the G1 segments curves are discretised into.
+        Chord length of the G1 moves, > 0.
     """
-    if not (stepover_mm > 0 and segment_mm > 0):
-        raise ValueError(
-            f"stepover_mm = {stepover_mm!r} and segment_mm = {segment_mm!r} must be > 0"
-        )
-    if spec.shape == "twin":  # two regions either side of a rib, cut left to right
-        cx, cy = spec.center_mm
-        w, h = spec.size_mm
-        regions = [
-            _region(
-                PocketSpec(
-                    0,
-                    "rounded",
-                    (cx + side * 0.275 * w, cy),
-                    (0.45 * w, h),
-                    spec.corner_radius_mm,
-                    spec.feed_mm_min,
-                ),
-                stepover_mm,
-                segment_mm,
-            )
-            for side in (-1.0, 1.0)
-        ]
-    else:
-        regions = [_region(spec, stepover_mm, segment_mm)]
+    for name, value in (("stepover_mm", stepover_mm), ("segment_mm", segment_mm)):
+        if not value > 0:
+            raise ValueError(f"{name} = {value!r} is out of range: allowed > 0")
     feed = spec.feed_mm_min
+    x0, y0, z0 = start_mm(spec, stepover_mm=stepover_mm)
     lines = [
         f"(nctwin thin-wall part, pocket {spec.number}: {spec.shape})",
         "G21 G90 G17",
-        f"G0 Z{HOME_MM[2]:.1f}",
+        f"G0 X{x0:.4f} Y{y0:.4f} Z{z0:.1f}",
     ]
-    for region in regions:
+    for region in _regions(spec, stepover_mm, segment_mm):
         for level in range(1, spec.depth_levels + 1):
-            x0, y0 = region[0][0]
+            x, y = region[0][0]
             lines += [
-                f"G0 X{x0:.4f} Y{y0:.4f}",
-                f"G0 Z{_SAFE_Z:.1f}",
-                f"G1 Z{-3.0 * level:.1f} F{0.3 * feed:g}",
+                f"G0 X{x:.4f} Y{y:.4f}",
+                f"G0 Z{1.0 - LEVEL_DEPTH_MM * (level - 1):.1f}",
+                f"G1 Z{-LEVEL_DEPTH_MM * level:.1f} F{0.3 * feed:g}",
                 f"F{feed:g}",
             ]
             for i, contour in enumerate(region):
                 if i:
                     lines.append(f"G1 X{contour[0, 0]:.4f} Y{contour[0, 1]:.4f}")  # link
-                dense = _split_long(contour, MAX_SEGMENT_MM)
+                dense = _split_long(contour, segment_mm)
                 lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in dense[1:]]
-            lines.append(f"G0 Z{_SAFE_Z:.1f}")
-    lines += [f"G0 Z{HOME_MM[2]:.1f}", "M30"]
+            lines.append(f"G0 Z{CLEARANCE_Z_MM:.1f}")
+    lines.append("M30")
     return "\n".join(lines) + "\n"
 
 

@@ -44,6 +44,7 @@ __all__ = [
     "global_program",
     "mixed_program",
     "program_text",
+    "specs_of",
     "training_specs",
 ]
 
@@ -244,16 +245,31 @@ def training_specs(
     Feeds and tolerances are uniform in their ranges (rounded to 1 mm/s and 0.005 mm, as a
     programmer would type them); each program gets its own seed from ``seed``.
     """
+    n_mixed = round(mixed_share * n_programs)
+    families = ["mixed"] * n_mixed + ["global"] * (n_programs - n_mixed)
+    return specs_of(seed, families, n_lines, feed_range_mm_s, tol_range_mm)
+
+
+def specs_of(
+    seed: int,
+    families: list[str],
+    n_lines: int,
+    feed_range_mm_s: tuple[float, float],
+    tol_range_mm: tuple[float, float],
+    spec: type[ProgramSpec] = ProgramSpec,
+) -> list[ProgramSpec]:
+    """One ``spec`` (:class:`ProgramSpec` or a subclass that knows more families) per entry of
+    ``families``: feeds and tolerances uniform in their ranges (rounded to 1 mm/s and 0.005 mm,
+    as a programmer would type them), each program with its own seed drawn from ``seed``."""
+    n_programs = len(families)
     if n_programs < 1 or n_lines < 2:
         raise ValueError(f"n_programs = {n_programs}, n_lines = {n_lines}: need >= 1 and >= 2")
     rng = np.random.default_rng(seed)
-    n_mixed = round(mixed_share * n_programs)
-    families = ["mixed"] * n_mixed + ["global"] * (n_programs - n_mixed)
     feeds = np.round(rng.uniform(*feed_range_mm_s, n_programs))
     tols = np.round(rng.uniform(*tol_range_mm, n_programs) / 0.005) * 0.005
     seeds = rng.integers(0, 2**63 - 1, n_programs)
     return [
-        ProgramSpec(f, n_lines, float(v), round(float(e), 4), int(s))
+        spec(f, n_lines, float(v), round(float(e), 4), int(s))
         for f, v, e, s in zip(families, feeds, tols, seeds, strict=True)
     ]
 

@@ -49,6 +49,7 @@ import pandas as pd
 
 from .. import paths
 from ..cache import atomic_write_text
+from .html import html_table
 
 __all__ = [
     "CITING_COLUMNS",
@@ -66,6 +67,8 @@ __all__ = [
     "load_paper_table",
     "paper_tables",
     "papers_dir",
+    "show",
+    "show_paper",
     "side_by_side",
     "write_claims",
     "write_table",
@@ -539,20 +542,8 @@ def format_table(df: pd.DataFrame) -> str:
     )
 
 
-def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
-    """Render a paper table with its citation as a title and its notes as footnotes.
-
-    The ``paper`` column and, when constant, ``table`` and ``page_or_section`` go into the title;
-    the ``note`` column becomes numbered footnotes (``[1]`` ...) referenced from a ``note``
-    column of numbers.
-
-    Parameters
-    ----------
-    df
-        Paper table from :func:`load_paper_table`.
-    name
-        Table name to show in the title, e.g. ``"chien2023_table1"``.
-    """
+def _paper_parts(df: pd.DataFrame, name: str | None) -> tuple[list[str], pd.DataFrame, list[str]]:
+    """Title parts, body and footnotes of a paper table (:func:`format_paper_table`)."""
     body = df.copy()
     title = [name] if name else []
     for column in CITING_COLUMNS:
@@ -572,6 +563,55 @@ def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
         body = body.drop(columns="note")
         if footnotes:
             body["note"] = refs
+    return title, body, footnotes
+
+
+def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
+    """Render a paper table with its citation as a title and its notes as footnotes.
+
+    The ``paper`` column and, when constant, ``table`` and ``page_or_section`` go into the title;
+    the ``note`` column becomes numbered footnotes (``[1]`` ...) referenced from a ``note``
+    column of numbers.
+
+    Parameters
+    ----------
+    df
+        Paper table from :func:`load_paper_table`.
+    name
+        Table name to show in the title, e.g. ``"chien2023_table1"``.
+    """
+    title, body, footnotes = _paper_parts(df, name)
     lines = [" | ".join(title), format_table(body)] if title else [format_table(body)]
     lines += [f"[{i}] {text}" for i, text in enumerate(footnotes, start=1)]
     return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# One table per result: HTML for the book, the same plain text for nbval
+
+
+def show(df: pd.DataFrame, *, digits: int = 4) -> None:
+    """Display a table once: compact HTML in the book, :func:`format_table` text for nbval.
+
+    One display object carries both forms: ``text/html`` (:func:`nctwin.report.html.html_table`,
+    floats to ``digits`` significant digits, the paper's columns grouped), which the book
+    renders, and ``text/plain``, exactly the text ``print(format_table(df))`` prints (without
+    its final newline), which nbval compares. A chapter cell calls ``show(table)`` where it
+    printed ``format_table(table)`` and displayed the frame.
+    """
+    from IPython.display import display
+
+    display({"text/plain": format_table(df), "text/html": html_table(df, digits=digits)}, raw=True)
+
+
+def show_paper(df: pd.DataFrame, name: str | None = None) -> None:
+    """Display a paper table once: the citation as caption, the notes as footnotes.
+
+    ``text/plain`` is :func:`format_paper_table`; the HTML shows the numbers with six
+    significant digits, as the CSV holds them.
+    """
+    from IPython.display import display
+
+    title, body, footnotes = _paper_parts(df, name)
+    page = html_table(body, digits=6, prefix="", caption=" | ".join(title), notes=footnotes)
+    display({"text/plain": format_paper_table(df, name), "text/html": page}, raw=True)

@@ -1,0 +1,214 @@
+"""The Verdicts page: every claim of every chapter in one table, from ``results/*/claims.json``.
+
+``make book`` runs ``python -m nctwin.report.verdicts book/verdicts.md`` before Jupyter Book, so
+the page always shows the claims the committed (or just re-executed) notebooks wrote. It is a
+Markdown page, not a notebook: it computes nothing, only reads the JSON files, and its links to
+the chapters are MyST links that Sphinx checks (a missing section fails ``make book``).
+
+One row per claim: the chapter, the claim's id and text, the paper's value, ours, the bar it is
+judged against, the verdict, and a link to the section that explains it. The paper's value is
+the record's ``paper`` field where a chapter gives one, else what the claim's text quotes after
+"paper" (``"(paper 0.8-2.2 %)"`` gives ``0.8-2.2 %``), else empty. The section is the one whose
+prose names the claim's id (in backticks or not); if none does, the section holding the
+notebook's ``report_claims`` cell.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from .. import paths
+from .html import format_value
+
+__all__ = ["ChapterClaims", "chapter_claims", "paper_value", "render", "section_of", "slugify"]
+
+#: The text a claim quotes as the paper's value: "(paper 3-6 %)", "(..; paper: 20.8 %, Sec. 3.2)".
+_PAPER_IN_TEXT = re.compile(r"\bpaper:? ([^;)]+)")
+#: Deepest heading level that gets an anchor (``myst_heading_anchors`` in book/_config.yml).
+HEADING_ANCHORS = 4
+
+
+def slugify(title: str) -> str:
+    """The anchor MyST gives a heading (GitHub style, as ``mdit_py_plugins.anchors``).
+
+    Examples
+    --------
+    >>> slugify('Table 3 analogue: "machine B"')
+    'table-3-analogue-machine-b'
+    """
+    return re.sub(r"[^\w\u4e00-\u9fff\- ]", "", title.lower().replace(" ", "-"))
+
+
+def paper_value(record: dict) -> str:
+    """The paper's value of a claim record: its ``paper`` field, else quoted in its text."""
+    if record.get("paper"):
+        return str(record["paper"])
+    match = _PAPER_IN_TEXT.search(record.get("text", ""))
+    return match.group(1).strip() if match else ""
+
+
+@dataclass(frozen=True)
+class ChapterClaims:
+    """One chapter's claims and where its notebook explains them.
+
+    Attributes
+    ----------
+    stem
+        Notebook stem, e.g. ``"chien2023_bilstm"``.
+    title
+        The notebook's first heading.
+    claims
+        The records of ``results/<stem>/claims.json``.
+    headings
+        ``(cell index, level, text, slug)`` of every heading of the notebook's Markdown cells.
+    sources
+        Source of every cell, by index.
+    """
+
+    stem: str
+    title: str
+    claims: list[dict]
+    headings: list[tuple[int, int, str, str]]
+    sources: list[tuple[str, str]]
+
+
+def _headings(cells: list[dict]) -> list[tuple[int, int, str, str]]:
+    out, seen = [], set()
+    for i, cell in enumerate(cells):
+        if cell["cell_type"] != "markdown":
+            continue
+        fence = False
+        for line in "".join(cell["source"]).splitlines():
+            if line.lstrip().startswith(("```", "~~~")):
+                fence = not fence
+            match = None if fence else re.match(r"^(#{1,6})\s+(.*?)\s*#*\s*$", line)
+            if match:
+                text = re.sub(r"[`*]", "", match.group(2))
+                slug = base = slugify(text)
+                k = 0
+                while slug in seen:
+                    k += 1
+                    slug = f"{base}-{k}"
+                seen.add(slug)
+                out.append((i, len(match.group(1)), text, slug))
+    return out
+
+
+def chapter_claims(stem: str, results_dir: Path, notebooks_dir: Path) -> ChapterClaims:
+    """Read one chapter's claims and its notebook's headings."""
+    claims = json.loads((results_dir / stem / "claims.json").read_text(encoding="utf-8"))
+    cells = json.loads((notebooks_dir / f"{stem}.ipynb").read_text(encoding="utf-8"))["cells"]
+    headings = _headings(cells)
+    title = next((t for _, level, t, _ in headings if level == 1), stem)
+    sources = [(c["cell_type"], "".join(c["source"])) for c in cells]
+    return ChapterClaims(stem, title, claims, headings, sources)
+
+
+def section_of(chapter: ChapterClaims, claim_id: str) -> tuple[str, str]:
+    """``(heading text, slug)`` of the section that explains a claim ("" slug: the chapter).
+
+    The first Markdown cell naming ``claim_id`` as a word decides; if none does, the cell that
+    calls ``report_claims``. The section is the last heading (level 2 to
+    :data:`HEADING_ANCHORS`) at or before that cell.
+    """
+    word = re.compile(rf"(?<![\w-]){re.escape(claim_id)}(?![\w-])")
+    cell = next(
+        (
+            i
+            for i, (kind, src) in enumerate(chapter.sources)
+            if kind == "markdown" and word.search(src)
+        ),
+        None,
+    )
+    if cell is None:
+        cell = next(
+            (i for i, (kind, src) in enumerate(chapter.sources)
+             if kind == "code" and "report_claims(" in src),
+            len(chapter.sources),
+        )  # fmt: skip
+    before = [h for h in chapter.headings if h[0] <= cell and 2 <= h[1] <= HEADING_ANCHORS]
+    return (before[-1][2], before[-1][3]) if before else (chapter.title, "")
+
+
+def _cell(text: str) -> str:
+    """Text safe in a Markdown table cell."""
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def _number(value: float | None) -> str:
+    return (
+        "-"
+        if value is None or (isinstance(value, float) and math.isnan(value))
+        else (format_value(float(value), 4))
+    )
+
+
+def render(chapters: list[ChapterClaims]) -> str:
+    """The Verdicts page as MyST Markdown."""
+    n = sum(len(c.claims) for c in chapters)
+    holds = sum(bool(r["holds"]) for c in chapters for r in c.claims)
+    lines = [
+        "# Verdicts",
+        "",
+        "<!-- Generated by `python -m nctwin.report.verdicts` from results/*/claims.json "
+        "(make book); do not edit. -->",
+        "",
+        f"Every claim the chapters check, {n} in all, of which {holds} hold on the virtual "
+        "machine tool. Each is the paper's own claim at its own level, judged by the bar in the "
+        "*bar* column (our value, compared with the threshold); *paper* is the value the paper "
+        "reports where the claim quotes one. The link leads to the section of the chapter that "
+        "explains the verdict. A claim that fails is kept and explained there, not dropped.",
+        "",
+        ":::{container} nctwin-verdicts",
+        "| chapter | claim | paper | ours | bar | verdict | explained in |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for chapter in chapters:
+        short = chapter.title.split(":")[0]
+        for r in chapter.claims:
+            heading, slug = section_of(chapter, r["id"])
+            target = f"notebooks/{chapter.stem}.ipynb" + (f"#{slug}" if slug else "")
+            verdict = (
+                '<span class="nctwin-holds">holds</span>'
+                if r["holds"]
+                else '<span class="nctwin-fails">fails</span>'
+            )
+            lines.append(
+                f"| {_cell(short)} | **{_cell(r['id'])}**: {_cell(r['text'])} "
+                f"| {_cell(paper_value(r))} | {_number(r['value'])} "
+                f"| {r['op']} {_number(r['threshold'])} | {verdict} "
+                f"| [{_cell(heading)}]({target}) |"
+            )
+    lines.append(":::")
+    return "\n".join(lines) + "\n"
+
+
+def chapters_in_order(toc: Path, results_dir: Path, notebooks_dir: Path) -> list[ChapterClaims]:
+    """Every chapter with a ``claims.json``, in the order of the book's table of contents."""
+    stems = sorted(p.parent.name for p in results_dir.glob("*/claims.json"))
+    order = re.findall(r"file:\s*notebooks/([\w.-]+)", toc.read_text(encoding="utf-8"))
+    stems.sort(key=lambda s: (order.index(s) if s in order else len(order), s))
+    return [chapter_claims(s, results_dir, notebooks_dir) for s in stems]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m nctwin.report.verdicts OUT.md``: write the page (default book/verdicts.md)."""
+    argv = sys.argv[1:] if argv is None else argv
+    root = paths.repo_root()
+    out = Path(argv[0]) if argv else root / "book" / "verdicts.md"
+    chapters = chapters_in_order(
+        root / "book" / "_toc.yml", paths.results_dir(), root / "notebooks"
+    )
+    out.write_text(render(chapters), encoding="utf-8")
+    n = sum(len(c.claims) for c in chapters)
+    print(f"verdicts: {n} claims of {len(chapters)} chapters -> {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,105 @@
+"""The Denkena chapter's experiment design and scoring: semi-stability drawn independently of
+the load, windows from the set points, RMSE per window by hand, the claims' reading."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from nctwin.chapters import denkena2020 as dk
+from nctwin.chapters.denkena2020_bench import _segment
+from nctwin.physics import drives
+from nctwin.report.tables import load_paper_table
+
+GRID = {k: sorted(g["value"].astype(float))
+        for k, g in load_paper_table("denkena2020_table1").groupby("parameter")}  # fmt: skip
+
+
+def test_segment_travels_its_length_at_its_speed() -> None:
+    dt = 2e-4
+    s = _segment(50.0, 10.0, dt)
+    assert s[-1] == pytest.approx(50.0, abs=1e-9)
+    v = np.diff(s) / dt
+    assert v.max() == pytest.approx(10.0, rel=1e-9) and v.min() >= -1e-12
+    # 5 s at speed, plus the filter's 60 + 15 ms (each box T/dt + 1 taps)
+    assert len(s) - 1 == pytest.approx(5.0 / dt + 0.075 / dt + 2, abs=2)
+
+
+def test_semi_stability_is_independent_of_the_load() -> None:
+    procs = dk.design_processes(GRID, seed=0, semi_stable_share=0.5)
+    straight = pd.DataFrame([vars(p) for p in procs if p.kind in ("side", "groove")])
+    load = straight.ap_mm * straight.ae_mm
+    semi = straight.semi_stable
+    assert semi.any() and (load[semi] < 12.0).any()  # light cuts can be semi-stable too
+    assert not any(p.semi_stable for p in procs if p.kind in ("pocket", "ramp"))
+    test = straight[straight.test]
+    assert test.semi_stable.any() and (~test.semi_stable).any()
+    assert sum(p.test for p in procs) == 21
+    with pytest.raises(ValueError, match="semi_stable_share"):
+        dk.design_processes(GRID, seed=0, semi_stable_share=1.5)
+
+
+def test_windows_of_a_straight_cut_and_a_pocket() -> None:
+    procs = dk.design_processes(GRID, seed=0)
+    machine = drives.FeedDriveMachine()
+    cut_x = next(p for p in procs if p.feed_direction == "+x")
+    pocket = next(p for p in procs if p.kind == "pocket")
+    w = dk.process_windows([cut_x, pocket], machine, duration_s=6.0)
+    assert w.cutting.shape == (2, 1500) and w.moving.shape == (2, 1500, 3)
+    # a +x cut: X moves, Y and Z stand still all the time; it never reverses
+    assert w.moving[0, :, 0].any() and not w.moving[0, :, 1:].any()
+    assert not w.reversal[0].any()
+    # the tool is in the material only while X moves, and the record ends at rest
+    assert not (w.cutting[0] & ~w.moving[0, :, 0]).any() and not w.moving[0, -1].any()
+    # a ccw circle reverses X and Y while cutting
+    assert w.reversal[1, :, 0].any() and w.reversal[1, :, 1].any()
+    assert not (w.reversal[1] & ~w.cutting[1, :, None]).any()
+    with pytest.raises(ValueError, match="reversal_s"):
+        dk.process_windows([cut_x], machine, duration_s=6.0, reversal_s=0.0)
+
+
+def test_rmse_per_window_by_hand() -> None:
+    procs = dk.design_processes(GRID, seed=0)
+    p = next(q for q in procs if q.test)
+    n = 4
+
+    rec = SimpleNamespace(processes=[p])  # the one field table2 reads
+
+    targets = np.zeros((p.index + 1, n, 3))
+    targets[p.index, :, 0] = [0.0, 10.0, -20.0, 0.0]
+    lstm = {p.index: np.zeros((n, 3))}
+    lstm[p.index][:, 0] = 1.0
+    model = {p.index: np.zeros((n, 3))}
+    cutting = np.zeros((p.index + 1, n), dtype=bool)
+    cutting[p.index, 1:3] = True
+    moving = np.zeros((p.index + 1, n, 3), dtype=bool)
+    moving[p.index, :3, 0] = True
+    w = dk.Windows(cutting, moving, np.zeros_like(moving))
+    row = dk.table2(rec, targets, lstm, model, w, axes="X").iloc[0]
+    # model error over the cut: (-10, 20) -> sqrt(250); LSTM: (-9, 21) -> sqrt(261)
+    assert row.model_cutting_rmse_n == pytest.approx(np.sqrt(250.0))
+    assert row.lstm_cutting_rmse_n == pytest.approx(np.sqrt(261.0))
+    assert row.model_rmse_n == pytest.approx(np.sqrt(500.0 / 4))
+    assert row.model_standstill_rmse_n == 0.0  # the last sample only
+    assert row.max_abs_force_n == 20.0
+    assert row.model_cutting_nrmse == pytest.approx(np.sqrt(250.0) / 20.0)
+
+
+def test_two_sided_band_claims() -> None:
+    table = pd.DataFrame({"process": ["circular pocket", "side milling"],
+                          "lstm_cutting_rmse_n": [10.0, 20.0],
+                          "model_cutting_rmse_n": [30.0, 10.0],
+                          "lstm_cutting_nrmse": [0.1, 0.3],
+                          "semi_stable": [False, True]})  # fmt: skip
+    summary = pd.DataFrame({"lstm_lower_pct": [40.0]})
+    reversal = pd.DataFrame({"window": ["reversal windows", "rest of the cut"],
+                             "lstm_rmse_n": [5.0, 5.0], "model_rmse_n": [20.0, 10.0]})  # fmt: skip
+    claims = {c.id: c for c in dk.claims(table, summary, reversal, (10.0, 35.0))}
+    assert claims["lstm_lower_at_least"].holds and not claims["lstm_lower_at_most"].holds
+    assert claims["reversal_model_fails"].value == 2.0
+    assert claims["reversal_model_worse"].value == 15.0
+    assert claims["pocket_model_worse"].value == 20.0
+    assert claims["worst_lstm_semi_stable"].holds

@@ -1,0 +1,125 @@
+"""The chapter on Lee et al. 2022: its programs, its truths with one effect on, its tables and
+claims, against numbers computed by hand."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from nctwin import parse
+from nctwin.chapters import lee2022 as lee
+from nctwin.estimate.block_overlap import block_overlap
+from nctwin.kernel import fanuc
+from nctwin.methods.lee2022 import check_program
+from nctwin.paths import data_dir
+from nctwin.recordings import load_recordings
+from nctwin.report.tables import load_paper_table
+
+PAPER = load_paper_table("lee2022_validation")
+SETS = lee.parameter_sets("fanuc_0i_testbed", PAPER)
+
+
+def truth_with(effect: str, s: int = 1) -> fanuc.FanucSettings:
+    return lee._effect_settings(SETS[s][1], lee.EFFECTS[effect])
+
+
+@pytest.mark.parametrize("name", list(lee.PROGRAM_FILES))
+def test_shipped_programs_are_their_generators_output(name):
+    path = data_dir() / "programs" / lee.PROGRAM_FILES[name]
+    assert path.read_text(encoding="utf-8") == lee.program_text(name)
+    assert lee.load_program(name).allclose(parse(lee.program_text(name)))
+
+
+def test_unknown_program_and_unmodelled_constructs_are_refused():
+    with pytest.raises(ValueError, match="name = 'x' is out of range"):
+        lee.load_program("x")
+    with pytest.raises(ValueError, match=r"^p\.nc:3: exact-stop mode \(G61/G61\.1\)"):
+        check_program(parse("G1 X1 F100\nG61\nG1 X2"), "p.nc")
+    with pytest.raises(ValueError, match=r"^p\.nc:2: G64 P blending tolerance"):
+        check_program(parse("G64 P0.05\nG1 X1 F100"), "p.nc")
+
+
+def test_parameter_sets_are_the_papers():
+    for s, want in ((1, (0.15, 0.03, 0.05)), (2, (0.1, 0.02, 0.1))):
+        for c in SETS[s]:
+            assert (c.rapid_time_constant_s, c.rapid_bell_s, c.cut_time_constant_s) == want
+    # the profile's [fanuc] table is the testbed the defaults describe
+    assert SETS[1][1] == fanuc.PAPER_SET_1 and SETS[2][1] == fanuc.PAPER_SET_2
+
+
+def test_the_estimators_model_switches_every_effect_off():
+    none = truth_with("none (the estimator's model)")
+    assert none.arc_radial_acc_mm_s2 == math.inf and none.block_time_s == 0.0
+    assert none.inposition_width_mm == lee._NO_WAIT_MM and none.cut_accdec == "linear"
+    assert truth_with("all (the testbed)") == fanuc.PAPER_SET_1
+    for effect, changes in lee.EFFECTS.items():
+        if not changes:
+            continue
+        st = truth_with(effect)
+        differ = {k for k in changes if getattr(st, k) != getattr(none, k)}
+        assert differ == set(changes), effect
+
+
+def _both(text: str, effect: str) -> tuple[float, float]:
+    tp = parse(text)
+    m = SETS[1][0]
+    truth = fanuc.simulate(tp, m, truth_with(effect)).cycle_time_s
+    return truth, block_overlap(tp, m, inposition_s=(0.0, 0.0, 0.0)).cycle_time_s
+
+
+def test_arc_clamp_is_what_the_estimator_misses_on_a_lead_arc():
+    # half circle of R2 at F6000: the clamp sqrt(200 mm/s^2 * 2 mm) = 20 mm/s
+    text = "G1 X0.001 F6000\nG2 X4.001 I2"
+    length = 0.001 + 2 * math.pi
+    truth, pred = _both(text, "arc clamp")
+    assert pred == pytest.approx(0.001 + math.ceil(2 * math.pi / 100 / 0.001) * 0.001 + 0.05)
+    # a K-period moving average stretches m periods of input to m + K - 1 (eq. 3 adds K)
+    assert truth == pytest.approx(0.001 + math.ceil(2 * math.pi / 20 / 0.001) * 0.001 + 0.049)
+    truth_off, _ = _both(text, "none (the estimator's model)")
+    assert truth_off == pytest.approx(pred, abs=2e-3)
+    assert length / 100 < pred < truth
+
+
+def test_block_processing_time_limits_short_chords():
+    # ten chords of 0.1 mm at F6000: 1 ms each by eq. 2, at least 4 ms each on the truth
+    text = "\n".join(f"G1 X{0.1 * (k + 1):.1f} F6000" for k in range(10))
+    truth, pred = _both(text, "block-processing time")
+    assert pred == pytest.approx(10 * 0.001 + 0.05)
+    assert truth == pytest.approx(10 * 0.004 + 0.049)  # m + K - 1 periods, as above
+
+
+def test_claims_are_reported_not_asserted():
+    rows = []
+    for prog, err, cam in ((lee.TEST_PIECE, 0.05, -2.0), (lee.FINISHING_3D, -11.0, -40.0)):
+        for s in (1, 2):
+            for variant, e in (("full", err), ("no_overlap", 5.0), ("no_inposition", err - 1)):
+                rows.append({"program": prog, "param_set": s, "variant": variant,
+                             "accuracy_pct": 100 - abs(e), "err_pct": e,
+                             "cam_err_pct": cam})  # fmt: skip
+    claims = {c.id: c for c in lee.claims(pd.DataFrame(rows))}
+    assert len(claims) == 12
+    tp, f3 = f"{lee.TEST_PIECE}_set1", f"{lee.FINISHING_3D}_set2"
+    assert claims[f"accuracy_{tp}"].holds and not claims[f"accuracy_{f3}"].holds
+    assert claims[f"beats_cam_{tp}"].value == pytest.approx(40.0)
+    assert not claims[f"beats_cam_{f3}"].holds
+    assert claims[f"overlap_matters_{tp}"].value == pytest.approx(99.95 - 95.0)
+
+
+def test_inposition_table_is_beside_the_papers():
+    table = lee.inposition_table({1: np.array([0.05, 0.05, 0.06])}, load_paper_table(
+        "lee2022_inposition"))  # fmt: skip
+    assert list(table.axis) == ["X", "Y", "Z"]
+    np.testing.assert_allclose(table.inpos_ms, [50.0, 50.0, 60.0])
+    assert list(table.paper_inpos_ms) == [25, 25, 120]
+
+
+def test_out_of_domain_rows_per_group():
+    recs = load_recordings()
+    few = {k: recs[k] for k in sorted(recs) if k.startswith(("train_00", "test_"))}
+    table = lee.out_of_domain_table(few)
+    assert set(table.group) == {"train", "test"}
+    assert table.programs.sum() + table.not_read.sum() == len(few)
+    assert (table.max_abs_err_pct >= table.median_abs_err_pct).all()

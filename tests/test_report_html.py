@@ -1,0 +1,108 @@
+"""nctwin.report.html and tables.show: one table per result, HTML for the book, text for nbval."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from nctwin.report import tables
+from nctwin.report.html import format_value, html_table, short_header
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [
+        (99.95001796, "99.95"),
+        (2282.82, "2283"),  # never fewer digits than the integer part
+        (0.0026178, "0.002618"),
+        (3.0, "3"),
+        (-12.5, "-12.5"),
+        (0.0, "0"),
+        (1.5e-5, "1.500e-05"),
+        (np.float32(0.25), "0.25"),
+        (float("nan"), "-"),
+        (None, "-"),
+        (19800, "19800"),
+        ("I", "I"),
+    ],
+)
+def test_format_value(value, text):
+    assert format_value(value) == text
+
+
+def test_short_header():
+    assert short_header("paper_cam_err_pct") == "cam err (%)"
+    assert short_header("measured_s") == "measured (s)"
+    assert short_header("median_feed_mm_s") == "median feed (mm/s)"
+    assert short_header("pocket") == "pocket"
+    assert short_header("s") == "s"  # a bare suffix is a name
+
+
+def frame() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "toolpath": ["I", "II"],
+            "bilstm_err_pct": [3.2345678, 2.0],
+            "ok": [True, False],
+            "paper_bilstm_err_pct": [1.2, np.nan],
+            "paper_source": ["Chien et al. 2023, Table 1"] * 2,
+        }
+    )
+
+
+def test_html_groups_the_paper_columns():
+    page = html_table(frame())
+    assert page.startswith('<div class="nctwin-table"><table>')
+    assert '<th colspan="3"></th><th colspan="1" class="nctwin-paper nctwin-start">' in page
+    assert "paper (Chien et al. 2023, Table 1)" in page  # constant source: in the header
+    assert 'title="paper_bilstm_err_pct">bilstm err (%)</th>' in page
+    assert '<td class="nctwin-num">3.235</td>' in page
+    assert '<td class="nctwin-paper nctwin-start nctwin-num">-</td>' in page
+    assert "<td>True</td>" in page  # booleans are not right-aligned numbers
+    assert "index" not in page and html_table(frame()) == page  # no index, deterministic
+
+
+def test_html_escapes_and_notes():
+    page = html_table(pd.DataFrame({"a<b": ["x & y"]}), prefix="", caption="T | 1", notes=["n"])
+    assert "a&lt;b" in page and "x &amp; y" in page and "<caption>T | 1</caption>" in page
+    assert '<ol class="nctwin-notes"><li>n</li></ol>' in page
+
+
+def test_show_text_is_what_print_format_table_prints(monkeypatch):
+    shown = []
+    monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append((obj, raw)))
+    tables.show(frame())
+    ((obj, raw),) = shown
+    assert raw and obj["text/plain"] == tables.format_table(frame())
+    assert obj["text/html"] == html_table(frame())
+
+
+def test_show_paper_keeps_format_paper_table_text(monkeypatch):
+    shown = []
+    monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append(obj))
+    paper = pd.DataFrame(
+        {"paper": ["P"] * 2, "table": ["Table 1"] * 2, "x": [1.0, 2.0], "note": ["a", None]}
+    )
+    tables.show_paper(paper, "p_table1")
+    assert shown[0]["text/plain"] == tables.format_paper_table(paper, "p_table1")
+    assert "<caption>p_table1 | P | Table 1</caption>" in shown[0]["text/html"]
+    assert "<li>a</li>" in shown[0]["text/html"] and "<td>[1]</td>" in shown[0]["text/html"]
+
+
+def test_wide_short_tables_are_transposed():
+    wide = pd.DataFrame(
+        {f"c{i}_mm": [1.0 * i, 2.0 * i] for i in range(12)} | {"paper_c1_mm": [1.0, 2.0]}
+    )
+    page = html_table(wide)
+    assert '<thead><tr><th title="c0_mm">c0 (mm)</th><th>0</th><th>0</th></tr></thead>' in page
+    assert (
+        '<tr class="nctwin-paper nctwin-start-row"><th title="paper_c1_mm">c1 (mm) (paper)</th>'
+        in page
+    )
+    assert html_table(wide, transpose=False).count("<tr>") == 4  # group row, header, two rows
+    assert "nctwin-start-row" not in html_table(wide.iloc[:, :12])  # 12 columns: as they are
+
+
+def test_words_may_break_after_underscores():
+    assert "iso10791_<wbr>7_<wbr>test" in html_table(pd.DataFrame({"p": ["iso10791_7_test"]}))

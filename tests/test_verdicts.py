@@ -1,0 +1,109 @@
+"""nctwin.report.verdicts: the Verdicts page from claims.json files and the notebooks' headings."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from nctwin.report import verdicts
+from nctwin.report.tables import Claim, write_claims
+
+
+def notebook(path: Path, cells: list[tuple[str, str]]) -> None:
+    path.write_text(
+        json.dumps({"cells": [{"cell_type": k, "source": s} for k, s in cells]}), encoding="utf-8"
+    )
+
+
+@pytest.fixture
+def book(tmp_path: Path) -> Path:
+    """results/ with two chapters' claims, their notebooks and a toc listing b before a."""
+    write_claims("a_ch", [Claim("x_ok", "x <= 3 % (paper 0.8-2.2 %)", 1.0, "<=", 3.0)],
+                 results_dir=tmp_path / "results")  # fmt: skip
+    write_claims(
+        "b_ch",
+        [
+            Claim("y_bad", "y | z >= 20 %", 4.0, ">=", 20.0),
+            Claim("w", "w > 0", float("nan"), ">", 0),
+        ],
+        results_dir=tmp_path / "results",
+    )
+    (tmp_path / "notebooks").mkdir()
+    notebook(tmp_path / "notebooks" / "a_ch.ipynb", [
+        ("markdown", "# Paper A 2020: a method\n\nintro"),
+        ("markdown", "## Claims"),
+        ("code", "report_claims(STEM, ch.claims())"),
+    ])  # fmt: skip
+    notebook(tmp_path / "notebooks" / "b_ch.ipynb", [
+        ("markdown", "# Paper B 2021: b\n"),
+        ("markdown", "## Table 3 analogue: \"machine B\"\n\n```\n## not a heading\n```\n"),
+        ("markdown", "### Why `y_bad` fails\n\nThe claim `y_bad` fails because ..."),
+        ("markdown", "## Claims"),
+        ("code", "report_claims(STEM, ch.claims())"),
+    ])  # fmt: skip
+    (tmp_path / "_toc.yml").write_text(
+        "chapters:\n  - file: notebooks/b_ch\n  - file: notebooks/a_ch\n", encoding="utf-8"
+    )
+    return tmp_path
+
+
+def test_slugify_as_myst():
+    assert verdicts.slugify('Table 3 analogue: "machine B"') == "table-3-analogue-machine-b"
+    assert verdicts.slugify("Why y_bad fails") == "why-y_bad-fails"
+
+
+def test_paper_value_from_field_then_text():
+    assert verdicts.paper_value({"text": "e <= 3 % (paper 0.8-2.2 %)"}) == "0.8-2.2 %"
+    assert verdicts.paper_value({"text": "d (1 = yes; paper: Fig. 8, 88.6 N)"}) == "Fig. 8, 88.6 N"
+    assert verdicts.paper_value({"text": "the paper's setting"}) == ""
+    assert verdicts.paper_value({"text": "x (paper 1 %)", "paper": "2.2 %"}) == "2.2 %"
+
+
+def test_section_is_where_the_prose_names_the_claim(book):
+    ch = verdicts.chapter_claims("b_ch", book / "results", book / "notebooks")
+    assert ch.title == "Paper B 2021: b"
+    assert [h[3] for h in ch.headings] == [
+        "paper-b-2021-b", "table-3-analogue-machine-b", "why-y_bad-fails", "claims"
+    ]  # fmt: skip
+    assert verdicts.section_of(ch, "y_bad") == ("Why y_bad fails", "why-y_bad-fails")
+    # no prose names "w" as a word: the section of the report_claims cell
+    assert verdicts.section_of(ch, "w") == ("Claims", "claims")
+
+
+def test_page_has_one_row_per_claim_in_toc_order(book):
+    chapters = verdicts.chapters_in_order(book / "_toc.yml", book / "results", book / "notebooks")
+    assert [c.stem for c in chapters] == ["b_ch", "a_ch"]
+    page = verdicts.render(chapters)
+    rows = [ln for ln in page.splitlines() if ln.startswith("| ") and "---" not in ln][1:]
+    assert len(rows) == 3
+    assert "3 in all, of which 1 hold" in page
+    assert rows[0].startswith("| Paper B 2021 | **y_bad**: y \\| z >= 20 % |")
+    assert "fails" in rows[0] and "(notebooks/b_ch.ipynb#why-y_bad-fails)" in rows[0]
+    assert "| - | > 0 |" in rows[1]  # NaN value: not reproduced, fails
+    assert "| 0.8-2.2 % | 1 | <= 3 |" in rows[2] and "holds" in rows[2]
+    assert "(notebooks/a_ch.ipynb#claims)" in rows[2]
+
+
+def test_main_writes_the_page(book, tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(verdicts.paths, "repo_root", lambda: book)
+    monkeypatch.setenv("NCTWIN_RESULTS", str(book / "results"))
+    (book / "book").mkdir()
+    (book / "book" / "_toc.yml").write_text((book / "_toc.yml").read_text())
+    out = tmp_path / "verdicts.md"
+    assert verdicts.main([str(out)]) == 0
+    assert out.read_text().startswith("# Verdicts\n")
+    assert "3 claims of 2 chapters" in capsys.readouterr().out
+
+
+def test_the_repository_page_renders():
+    """Every committed claims.json has its notebook, and every claim a row."""
+    root = verdicts.paths.repo_root()
+    chapters = verdicts.chapters_in_order(
+        root / "book" / "_toc.yml", root / "results", root / "notebooks"
+    )
+    page = verdicts.render(chapters)
+    n = sum(len(c.claims) for c in chapters)
+    assert n > 0 and page.count("| holds") + page.count("fails</span>") >= 0
+    assert sum(ln.startswith("| ") for ln in page.splitlines()) == n + 2
