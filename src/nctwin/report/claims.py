@@ -67,8 +67,12 @@ def report_claims(
     verdicts: tuple[str, str] = VERDICTS,
     table: bool = False,
     results_dir: Path | None = None,
-) -> list[Claim]:
+) -> None:
     """Write the claims to ``results/<stem>/claims.json`` and print them.
+
+    Nothing is returned: a notebook's claims cell is this one call, and its only output is the
+    printed claims (a returned value would be a second output, which a kernel without input
+    history shows even behind a ``;``).
 
     Parameters
     ----------
@@ -84,11 +88,6 @@ def report_claims(
     results_dir : pathlib.Path, optional
         Results folder; default ``paths.results_dir()``.
 
-    Returns
-    -------
-    list of Claim
-        The claims, whether they hold or not.
-
     Raises
     ------
     ValueError
@@ -101,4 +100,3 @@ def report_claims(
     else:
         for c in claims:
             print(format_claim(c, line, verdicts))
-    return claims
