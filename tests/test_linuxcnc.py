@@ -6,6 +6,7 @@ has no jerk limit, so a straight line from rest to rest with a trapezoidal feed 
 ``L / F + F / A``.
 """
 
+import dataclasses
 import math
 import tempfile
 from pathlib import Path
@@ -241,3 +242,21 @@ def test_timeout_kills_the_instance_and_leaves_nothing(monkeypatch):
         lc.record("G21\nG4 P60\nM2\n", MACHINE, timeout_s=4.0)
     assert len(made) == 1 and Path(made[0]).name.startswith("nctwin-linuxcnc-")
     assert not Path(made[0]).exists()
+
+
+def test_samples_follow_a_subroutine_whose_lines_repeat():
+    """Blocks of lines 5, 6 (a subroutine) called twice from lines 9 and 10, with line 6
+    holding two blocks: samples reporting 5, 6, 9 (no motion), 5, 6 follow the program forward,
+    a repeated line goes to its next run, and a line with two blocks to its last block."""
+    block_line = np.array([2, 5, 6, 6, 5, 6, 6, 11])
+    sample_line = np.array([2, 2, 5, 6, 6, 9, 5, 5, 6, 11, 11])
+    rec = lc.Recording(
+        pos_mm=np.zeros((len(sample_line), 3)),
+        current_vel_mm_s=np.zeros(len(sample_line)),
+        program_line=sample_line,
+        in_position=np.ones(len(sample_line), bool),
+        period_s=PERIOD_S,
+        log="",
+    )
+    tp = dataclasses.replace(parse("G1 X1 F600\n" * 8), line=block_line)
+    assert lc.motion_of(rec, tp).block.tolist() == [0, 0, 1, 3, 3, 3, 4, 4, 6, 7, 7]

@@ -487,14 +487,43 @@ def motion_of(rec: Recording, toolpath: Toolpath) -> Motion:
 
     The block of a sample is the last block whose source line is at most the program line
     LinuxCNC reports (lines without motion map to the block before them), made non-decreasing.
+    Where the blocks' lines are not in order (a subroutine's lines run again at every call),
+    the program is followed forward: a sample goes to the first run of blocks at or after the
+    previous sample's block that has its line (its last block, as above), and a line that no
+    later block has keeps the previous block.
     """
     n = len(rec.pos_mm)
     vel = np.zeros((n, 3))
     vel[1:] = np.diff(rec.pos_mm, axis=0) / rec.period_s
-    if len(toolpath):
+    if not len(toolpath):
+        block = np.zeros(n, dtype=np.int64)
+    elif np.all(np.diff(toolpath.line) >= 0):
         block = np.searchsorted(toolpath.line, rec.program_line, side="right") - 1
         block = np.maximum.accumulate(np.clip(block, 0, len(toolpath) - 1))
     else:
-        block = np.zeros(n, dtype=np.int64)
+        block = _follow_lines(toolpath.line, rec.program_line)
     t = np.arange(n) * rec.period_s
     return Motion(t, rec.pos_mm, vel, block.astype(np.int64), rec.period_s)
+
+
+def _follow_lines(block_line: np.ndarray, sample_line: np.ndarray) -> np.ndarray:
+    """The block of each sample (see :func:`motion_of`) for blocks whose lines (B,) are not in
+    order; ``sample_line`` (n,) are the lines LinuxCNC reported. Returns (n,) block indices."""
+    # runs of equal lines among the blocks: their first and last block and their line
+    first = np.flatnonzero(np.r_[True, block_line[1:] != block_line[:-1]])
+    last = np.r_[first[1:] - 1, len(block_line) - 1]
+    runs_of: dict[int, np.ndarray] = {}
+    for line in np.unique(block_line):
+        runs_of[int(line)] = np.flatnonzero(block_line[first] == line)
+    changes = np.flatnonzero(np.r_[True, sample_line[1:] != sample_line[:-1]])
+    run = 0
+    run_of_change = np.empty(len(changes), dtype=np.int64)
+    for k, i in enumerate(changes):
+        runs = runs_of.get(int(sample_line[i]))
+        if runs is not None:
+            j = np.searchsorted(runs, run)
+            if j < len(runs):
+                run = int(runs[j])
+        run_of_change[k] = run
+    counts = np.diff(np.r_[changes, len(sample_line)])
+    return last[np.repeat(run_of_change, counts)]

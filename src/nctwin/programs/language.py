@@ -1,0 +1,302 @@
+r"""Part programs in the whole RS274/NGC language, as a shop's CAM system or a programmer at the
+machine writes them: canned drilling cycles, cutter compensation, subroutines, parameters and
+expressions, offsets and units.
+
+Paper 1's training programs and the CAM-style programs (:mod:`nctwin.programs.training`,
+:mod:`nctwin.programs.camstyle`) are chains of G1 lines that the native reader reads. A shop's
+real programs are mostly not: a drilling job is a list of ``G81``/``G83`` cycles, a contour is
+programmed on the part's outline with ``G41``/``G42`` and the control offsets it by the tool's
+radius, a family of parts is one subroutine called with parameters. These programs exercise
+exactly those constructs, so that LinuxCNC's recordings of them check that a method times the
+moves LinuxCNC makes of them: the plunges and retracts of a cycle, the offset path with its
+entry move and the arcs that compensation inserts at outside corners, a subroutine's path
+repeated.
+
+Every program is fixed text (no random draw): :data:`LANGUAGE_PROGRAMS` maps a name to a
+function that returns it. All run on ``linuxcnc_sim`` (mm, X/Y 200 mm/s, Z 100 mm/s) in under
+a minute each. Cutter compensation is programmed with the tool diameter in the program
+(``G41.1``/``G42.1 D``), so the path does not depend on a tool table.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+__all__ = ["LANGUAGE_PROGRAMS", "language_program"]
+
+
+def drill_cycles() -> str:
+    """A 4 x 5 hole grid drilled with G81, spot-faced with G82 (dwell), peck-drilled with G83
+    and G73, bored with G85 and G89, in G98 and G99 retract modes, with L repeats in G91 and a
+    row in the ZX plane (G18)."""
+    return """\
+(nctwin language program: canned drilling cycles)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+F600
+G0 Z10
+G0 X0 Y0
+(row 1: centre drill G81, return to R between holes)
+G99 G81 X10 Y10 Z-2 R1 F300
+X25
+X40
+X55
+X70
+G80
+(row 2: spot face G82 with a dwell, return to the initial Z)
+G98 G82 X10 Y25 Z-3 R1 P0.2 F250
+X25
+X40
+X55
+X70
+G80
+(row 3: peck drilling G83, Q 2 mm)
+G0 Z12
+G99 G83 X10 Y40 Z-12 R2 Q2 F400
+X25
+X40
+G73 X55 Y40 Z-10 R2 Q1.5 F450
+X70
+G80
+(row 4: G91 with L repeats, incremental spacing 15 mm)
+G90 G0 X-5 Y55
+G91 G99 G81 X15 Y0 Z-4 R-9 L5 F350
+G90 G80
+(boring: G85 feeds out, G89 dwells at the bottom)
+G98 G85 X10 Y70 Z-6 R1 F200
+X40
+G89 X70 Y70 Z-6 R1 P0.3 F200
+G80
+(a row in the ZX plane, drilling along Y)
+G18 G0 Y5
+G99 G81 X10 Z-20 Y-3 R3 F300
+X30
+X50
+G80 G17
+G0 Z20
+G0 X0 Y0
+M2
+"""
+
+
+def cutter_compensation() -> str:
+    """An outside contour with rounded and sharp corners cut with G42.1 (right of the path,
+    climb milling outside), and an inside pocket wall with G41.1, each with a straight entry
+    move, an arc lead-in and G40 on the exit; tool diameter 6 mm then 10 mm."""
+    return """\
+(nctwin language program: cutter compensation)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+G0 Z5
+G0 X-20 Y-20
+G1 Z-2 F300
+(outside contour, right compensation, D 6 mm)
+G42.1 D6 F900
+G1 X0 Y-10
+G1 X0 Y0
+G1 X60 Y0
+G3 X70 Y10 R10
+G1 X70 Y40
+G3 X60 Y50 I-10 J0
+G1 X30 Y50
+G1 X20 Y35
+G1 X0 Y50
+G1 X0 Y0
+G1 X10 Y-10
+G40 G1 X-20 Y-20
+G0 Z5
+(inside wall of a 30 x 20 mm pocket, corners r 8, left compensation, D 10 mm)
+G0 X35 Y25
+G1 Z-3 F300
+G41.1 D10 F700
+G1 X35 Y15
+G1 X42
+G3 X50 Y23 I0 J8
+G1 Y27
+G3 X42 Y35 I-8 J0
+G1 X28
+G3 X20 Y27 I0 J-8
+G1 Y23
+G3 X28 Y15 I8 J0
+G1 X35
+G40 G1 X35 Y25
+G0 Z5
+(a circle of three turns around the part, compensation on)
+G0 X95 Y25
+G1 Z-1 F300
+G42.1 D6 F1200
+G1 X85 Y25
+G2 X85 Y25 I-50 J0 P3
+G40 G1 X95 Y25
+G0 Z20
+G0 X0 Y0
+M2
+"""
+
+
+def subroutines() -> str:
+    """One subroutine cuts a circular pocket at a centre, radius and depth given as parameters,
+    in step-downs (a while loop) and in rings (a nested while loop); it is called for six
+    pockets from a repeat loop, and a second subroutine with an if/else picks the depth."""
+    return """\
+(nctwin language program: subroutines, loops, parameters)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+#<_safe> = 5
+#<_stepdown> = 1.5
+#<_stepover> = 2.5
+o100 sub
+  (#1 x centre, #2 y centre, #3 radius, #4 depth, #5 feed)
+  G0 Z#<_safe>
+  G0 X#1 Y#2
+  G1 Z0 F[#5 / 3]
+  #<z> = 0
+  o110 while [#<z> GT -#4]
+    #<z> = [#<z> - #<_stepdown>]
+    o111 if [#<z> LT -#4]
+      #<z> = -#4
+    o111 endif
+    G1 Z#<z> F[#5 / 3]
+    #<r> = #<_stepover>
+    o120 while [#<r> LT #3]
+      G1 X[#1 + #<r>] Y#2 F#5
+      G3 X[#1 + #<r>] Y#2 I[-#<r>] J0
+      #<r> = [#<r> + #<_stepover>]
+    o120 endwhile
+    G1 X[#1 + #3] Y#2
+    G3 X[#1 + #3] Y#2 I[-#3] J0
+    G1 X#1 Y#2
+  o110 endwhile
+  G0 Z#<_safe>
+o100 endsub
+o200 sub
+  (#1 index: even pockets shallow, odd deep)
+  o210 if [[#1 MOD 2] EQ 0]
+    #<depth> = 3
+  o210 else
+    #<depth> = 4.5
+  o210 endif
+  o100 call [20 + 35 * [#1 MOD 3]] [20 + 35 * FIX[#1 / 3]] [8 + #1] [#<depth>] [900]
+o200 endsub
+G0 Z#<_safe>
+#<i> = 0
+o300 repeat [6]
+  o200 call [#<i>]
+  #<i> = [#<i> + 1]
+o300 endrepeat
+G0 Z20
+G0 X0 Y0
+M2
+"""
+
+
+def parametric_curve() -> str:
+    """An engraved rose curve r = 30 cos(4 t) (eight petals) in 1440 chords and an Archimedean
+    spiral in chords of about 1 mm, each computed in a while loop with named parameters, sin,
+    cos and an arc-length step."""
+    return """\
+(nctwin language program: parametric engraving)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.01
+#<cx> = 60
+#<cy> = 50
+G0 Z5
+G0 X[#<cx> + 30] Y#<cy>
+G1 Z-0.3 F200
+F1200
+(rose: 1440 chords, one every 0.25 degree of t)
+#<n> = 1440
+#<k> = 1
+o100 while [#<k> LE #<n>]
+  #<t> = [360 * #<k> / #<n>]
+  #<r> = [30 * COS[4 * #<t>]]
+  G1 X[#<cx> + #<r> * COS[#<t>]] Y[#<cy> + #<r> * SIN[#<t>]]
+  #<k> = [#<k> + 1]
+o100 endwhile
+G0 Z5
+(Archimedean spiral r = 2 + 1.5 t / 360, five turns, 1 mm chords)
+G0 X[#<cx> + 2] Y#<cy>
+G1 Z-0.3 F200
+F1500
+#<t> = 0
+o200 while [#<t> LT 1800]
+  #<r> = [2 + 1.5 * #<t> / 360]
+  #<t> = [#<t> + 180 / [3.14159265358979 * #<r>]]
+  G1 X[#<cx> + #<r> * COS[#<t>]] Y[#<cy> + #<r> * SIN[#<t>]]
+o200 endwhile
+G0 Z20
+G0 X0 Y0
+M2
+"""
+
+
+def offsets_units() -> str:
+    """A slot pattern (a subroutine) cut twice, at a G92 offset and at another after G92.1,
+    then a slot in inches at a G92 offset again, with G43 H and G49 around it and a G53 move to
+    a machine position. The units line ``G20 F40`` sets F before the units change, as LinuxCNC
+    executes a line: the plunge after it runs at 40 mm/min, not 40 in/min."""
+    return """\
+(nctwin language program: offsets and units)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.05
+o100 sub
+  G0 Z2
+  G0 X0 Y0
+  G1 Z-1 F300
+  G1 X40 F1000
+  G3 X40 Y10 R5
+  G1 X0
+  G2 X0 Y20 R5
+  G1 X40
+  G0 Z2
+o100 endsub
+G43 H0
+G0 X0 Y0 Z5
+G92 X-10 Y-10
+o100 call
+G92.1
+G0 X60 Y0
+G92 X0 Y0
+o100 call
+G92.1
+G20 F40
+G0 X0 Y1.5 Z0.2
+G92 X0 Y0
+G1 Z-0.04
+F30
+G1 X1.6
+G3 X1.6 Y0.4 R0.2
+G1 X0
+G0 Z0.2
+G92.1
+G21
+G49
+G53 G0 Z20
+G0 X0 Y0
+M2
+"""
+
+
+#: Name -> function returning the program's text.
+LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
+    "drill_cycles": drill_cycles,
+    "cutter_compensation": cutter_compensation,
+    "subroutines": subroutines,
+    "parametric_curve": parametric_curve,
+    "offsets_units": offsets_units,
+}
+
+
+def language_program(name: str) -> str:
+    """The text of the language program ``name`` (a key of :data:`LANGUAGE_PROGRAMS`).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not one of them.
+    """
+    if name not in LANGUAGE_PROGRAMS:
+        raise ValueError(
+            f"name = {name!r} is not allowed: allowed {', '.join(sorted(LANGUAGE_PROGRAMS))}"
+        )
+    return LANGUAGE_PROGRAMS[name]()
