@@ -122,6 +122,14 @@ import numpy as np
 from ..machine import MachineProfile
 from ..naivecam import merge_naive_cam
 from ..toolpath import MotionKind, PathMode, Toolpath
+from .blend_junctions import (
+    ARC_BLEND,
+    KINK_RATIO,
+    PARABOLIC_BLEND,
+    TANGENT_BLEND,
+    arc_junctions,
+    blend_plane_acc,
+)
 from .blend_speeds import optimised_end_speeds, segment_times, stops_on_periods
 from .result import Estimate
 
@@ -150,9 +158,6 @@ MIN_SEGMENT_CYCLES = 1.02
 #: A line remainder shorter than this many periods at the next arc's speed joins the arc
 #: (``ARC_BLEND_GAP_CYCLES``).
 GAP_CYCLES = 4
-#: A junction whose kink needs less than this share of an axis's acceleration is passed as
-#: tangent, without a blend arc or a stop (``ARC_BLEND_TANGENT_KINK_RATIO``, default 0.1).
-KINK_RATIO = 0.1
 #: What a stop costs beyond its trapezoids (:func:`blend_planner`'s ``stop_periods``).
 STOP_PERIODS = ("whole", "mean", "off")
 
@@ -180,6 +185,29 @@ def move_limits(
         Share of the acceleration each move may use (LinuxCNC halves it on both moves of a
         parabolic blend, ``tcGetOverallMaxAccel``); 1 by default.
     """
+    v_axes, acc = path_limits(moves, machine)
+    if acc_scale is not None:
+        acc = acc * acc_scale
+    rapid = moves.kind == MotionKind.RAPID
+    feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
+    feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
+    arc = np.flatnonzero(moves.is_arc)
+    if len(arc):
+        r, a, f = moves.radius_mm[arc], acc[arc], feed[arc]
+        a_normal = f**2 / r
+        cut = a_normal > NORMAL_ACC_RATIO * a
+        feed[arc] = np.where(cut, np.sqrt(NORMAL_ACC_RATIO * a * r), f)
+        ratio = np.sqrt(np.maximum(1.0 - (a_normal / a) ** 2, 0.0))
+        acc[arc] = a * np.where(cut, TANGENTIAL_ACC_RATIO, ratio)
+    return feed, acc
+
+
+def path_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, np.ndarray]:
+    r"""Velocity and acceleration the axes allow along each move, shapes (M,):
+    :math:`\min_i v_{i,\max} / |u_i|` and :math:`\min_i a_{i,\max} / |u_i|` with :math:`u`
+    the move's direction, an arc's plane axes taking its planar share and the third its helical
+    share (canon's ``getStraightVelocity``, ``getStraightAcceleration``; LinuxCNC's
+    ``maxaccel`` of a move)."""
     vmax = np.asarray(machine.axis_max_velocity_mm_s)
     amax = np.asarray(machine.axis_max_acceleration_mm_s2)
     share = np.abs(moves.directions)  # of each axis in the move's length
@@ -194,46 +222,7 @@ def move_limits(
         s[rows, ax[:, 2]] = np.sqrt(np.maximum(1.0 - planar**2, 0.0))
         share[arc] = s
     with np.errstate(divide="ignore"):
-        v_axes = np.min(vmax / share, axis=1)
-        acc = np.min(amax / share, axis=1)
-    if acc_scale is not None:
-        acc = acc * acc_scale
-    rapid = moves.kind == MotionKind.RAPID
-    feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
-    feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
-    if len(arc):
-        r, a, f = moves.radius_mm[arc], acc[arc], feed[arc]
-        a_normal = f**2 / r
-        cut = a_normal > NORMAL_ACC_RATIO * a
-        feed[arc] = np.where(cut, np.sqrt(NORMAL_ACC_RATIO * a * r), f)
-        ratio = np.sqrt(np.maximum(1.0 - (a_normal / a) ** 2, 0.0))
-        acc[arc] = a * np.where(cut, TANGENTIAL_ACC_RATIO, ratio)
-    return feed, acc
-
-
-def blend_plane_acc(u1: np.ndarray, u2: np.ndarray, axis_acc_mm_s2: np.ndarray) -> np.ndarray:
-    r"""Acceleration of blend arcs in the plane of two directions (LinuxCNC's
-    ``calculateInscribedDiameter``): :math:`\min_i a_{i,\max} / \sqrt{1 - n_i^2}` with
-    :math:`n = u_1 \times u_2 / |u_1 \times u_2|` the plane's normal; ``inf`` where the
-    directions are parallel (no plane).
-
-    Parameters
-    ----------
-    u1, u2 : ndarray, shape (K, 3)
-        Unit directions of the moves before and after each junction.
-    axis_acc_mm_s2 : ndarray, shape (3,)
-
-    Returns
-    -------
-    ndarray, shape (K,)
-    """
-    n = np.cross(u1, u2)
-    norm = np.linalg.norm(n, axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        n = n / norm[:, None]
-        in_plane = np.sqrt(np.maximum(1.0 - n**2, 0.0))  # share of each axis in the plane
-        acc = np.min(np.asarray(axis_acc_mm_s2) / in_plane, axis=1)
-    return np.where(norm > 0, acc, np.inf)
+        return np.min(vmax / share, axis=1), np.min(amax / share, axis=1)
 
 
 def junction_blends(
@@ -352,15 +341,21 @@ def tangent_junctions(
 
 
 def parabolic_junctions(
-    moves: Toolpath, tol_mm: np.ndarray, stop_turn_rad: float = STOP_TURN_RAD
+    moves: Toolpath,
+    tol_mm: np.ndarray,
+    stop_turn_rad: float = STOP_TURN_RAD,
+    *,
+    in_plane: bool = False,
 ) -> np.ndarray:
     """Junctions of M moves that LinuxCNC joins with a parabolic blend, shape (M - 1,).
 
     A junction with a circular move gets a blend arc only if the other move lies in the arc's
     plane (two arcs: parallel planes); otherwise ``tpCreateLineArcBlend`` (``ArcLine``,
-    ``ArcArc``) fails and ``tpChooseBestBlend`` falls back to a parabolic blend. Straight-on
-    junctions, stops (a tolerance of 0, a near-reversal) and line-line junctions are not
-    parabolic.
+    ``ArcArc``) fails and ``tpChooseBestBlend`` falls back to a parabolic blend (or, with the
+    planner's ``arc_blends``, to a tangent pass where that is faster). Straight-on junctions,
+    stops (a tolerance of 0, a near-reversal) and line-line junctions are not parabolic.
+    ``in_plane=True`` keeps the junctions in the arc's plane too: every junction with an arc
+    that is blended somehow.
     """
     m = len(moves)
     arc = moves.is_arc
@@ -375,12 +370,13 @@ def parabolic_junctions(
     def parallel(x: np.ndarray, y: np.ndarray) -> np.ndarray:
         return np.abs(np.abs(np.einsum("ij,ij->i", x, y)) - 1.0) < 1e-6
 
-    in_plane = (parallel(b, normal[:-1]) | ~arc[:-1]) & (parallel(b, normal[1:]) | ~arc[1:])
-    in_plane &= ~(arc[:-1] & arc[1:]) | parallel(normal[:-1], normal[1:])
+    planar = (parallel(b, normal[:-1]) | ~arc[:-1]) & (parallel(b, normal[1:]) | ~arc[1:])
+    planar &= ~(arc[:-1] & arc[1:]) | parallel(normal[:-1], normal[1:])
     dot = np.clip(np.einsum("ij,ij->i", u1, u2), -1.0, 1.0)
     straight = dot >= 1.0 - 1e-12
     reversal = np.arccos(-dot) < stop_turn_rad  # stops
-    return (arc[:-1] | arc[1:]) & (tol_mm[1:] > 0) & ~straight & ~reversal & ~in_plane
+    blended = (arc[:-1] | arc[1:]) & (tol_mm[1:] > 0) & ~straight & ~reversal
+    return blended if in_plane else blended & ~planar
 
 
 def parabolic_blend_speeds(
@@ -419,6 +415,7 @@ def blend_planner(
     *,
     kinks: bool = True,
     sized_arcs: bool = True,
+    arc_blends: bool = True,
     stop_periods: str = "whole",
     stop_turn_rad: float = STOP_TURN_RAD,
 ) -> Estimate:
@@ -434,6 +431,10 @@ def blend_planner(
         LinuxCNC's rules for nearly tangent junctions and G61's reduced acceleration
         (:func:`tangent_junctions`), and for the size of blend arcs (:func:`junction_blends`);
         both on by default, off only for the ablation that shows what each is worth.
+    arc_blends : bool
+        LinuxCNC's blend arcs at junctions with a programmed arc, and what replaces them where
+        they fail or are slower (:func:`~nctwin.estimate.blend_junctions.arc_junctions`); on by
+        default (needs ``kinks``), off for the ablation: the line-line formula on the tangents.
     stop_periods : {"whole", "mean", "off"}
         ``whole``: the tool comes to rest on a servo period (:func:`stops_on_periods`), as on
         LinuxCNC; ``mean``: each stop adds half a period instead, the mean of the same on
@@ -479,7 +480,20 @@ def blend_planner(
     tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, machine.period_s)
     tangent &= ~stop & kinks
     exact = (tol[1:] == 0) & ~stop & ~tangent & kinks
-    reduce = np.where(tangent, kink, np.where(exact, KINK_RATIO, 0.0))
+    # a junction with an arc: a blend arc as LinuxCNC makes it, if it beats a tangent pass at
+    # the kink speed and a parabolic blend (blend_junctions); the tangent pass keeps both
+    # moves at 1 - KINK_RATIO
+    candidates = parabolic_junctions(moves, tol, stop_turn_rad, in_plane=True) & ~tangent
+    if not (arc_blends and kinks):
+        candidates[:] = False
+    speed = np.minimum(feed, length / machine.period_s)
+    path_acc = path_limits(moves, machine)[1]
+    axis_vel = np.asarray(machine.axis_max_velocity_mm_s)
+    choice = arc_junctions(
+        moves, candidates, speed, path_acc, tol[1:], kink, axis_acc, axis_vel, machine.period_s
+    )
+    kinked = choice["choice"] == TANGENT_BLEND
+    reduce = np.where(tangent, kink, np.where(exact | kinked, KINK_RATIO, 0.0))
     kept = np.ones(len(moves))
     kept[:-1] = 1.0 - reduce
     kept[1:] = np.minimum(kept[1:], 1.0 - reduce)
@@ -497,7 +511,14 @@ def blend_planner(
     )
     # junctions with an arc that get no blend arc: a parabolic blend, both moves at half their
     # acceleration (halved once, with a parabolic end too)
-    para = parabolic_junctions(moves, tol, stop_turn_rad) & ~tangent
+    para = parabolic_junctions(moves, tol, stop_turn_rad) & ~tangent & ~candidates
+    para |= choice["choice"] == PARABOLIC_BLEND
+    made = choice["choice"] == ARC_BLEND
+    d_end, d_start = np.where(made, choice["trim1"], d), np.where(made, choice["trim2"], d)
+    v = np.where(made, np.minimum(choice["v_plan"], np.minimum(feed[:-1], feed[1:])), v)
+    arc = np.where(made, choice["length"], arc)
+    v = np.where(kinked, choice["kink_speed"], v)
+    d_end, d_start, arc = (np.where(kinked, 0.0, x) for x in (d_end, d_start, arc))
     halved = np.zeros(len(moves), bool)
     halved[:-1] |= para
     halved[1:] |= para
@@ -507,23 +528,20 @@ def blend_planner(
             length, feed, acc, moves.end_tangents, moves.start_tangents, tol
         )
         v = np.where(para, speed, v)
-        d = np.where(para, 0.0, d)
-        arc = np.where(para, 0.0, arc)
     v = np.where(tangent, np.minimum(feed[:-1], feed[1:]), v)
-    d = np.where(tangent, 0.0, d)
-    arc = np.where(tangent, 0.0, arc)
+    d_end, d_start, arc = (np.where(tangent | para, 0.0, x) for x in (d_end, d_start, arc))
     # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed
     a_line = acc * np.where(parabolic_end & ~halved, TANGENTIAL_ACC_RATIO, 1.0)
     v = np.where(parabolic_end[1:], np.minimum(v, np.sqrt(a_line * length)[1:]), v)
     # the queue: line 0, arc 0, line 1, ..., line M-1; the arcs of unblended junctions empty
     m = len(moves)
     item_len = np.empty(2 * m - 1)
-    item_len[0::2] = length - np.concatenate([[0.0], d]) - np.concatenate([d, [0.0]])
+    item_len[0::2] = length - np.concatenate([[0.0], d_start]) - np.concatenate([d_end, [0.0]])
     item_len[1::2] = arc
     # a line remainder the next arc passes in under GAP_CYCLES periods becomes part of it
     rem = item_len[0:-1:2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        eat = (arc > 0) & (rem < GAP_CYCLES * machine.period_s * v)
+        eat = (arc > 0) & (rem < GAP_CYCLES * machine.period_s * v) & ~moves.is_arc[:-1]
     item_len[1::2] += np.where(eat, rem, 0.0)
     item_len[0:-1:2] = np.where(eat, 0.0, rem)
     item_acc = np.empty(2 * m - 1)
@@ -550,7 +568,7 @@ def blend_planner(
     blended = limit > 0
     blended[-1] = False
     queued = np.arange(1, m)  # move s is queued after the arc that joins it to move s - 1
-    new_len = length[1:] - d
+    new_len = length[1:] - d_start
     if m > 1:
         new_len[-1] = length[-1]  # the last move: its measured entry, sqrt(a L / 2)
     end = optimised_end_speeds(
