@@ -85,6 +85,9 @@ _ARC_ARC_THETA_MIN = math.pi / 12.0
 #: A junction whose kink needs less than this share of an axis's acceleration is passed as
 #: tangent, without a blend arc or a stop (``ARC_BLEND_TANGENT_KINK_RATIO``, default 0.1).
 KINK_RATIO = 0.1
+#: A line's remainder the blend arc passes in under this many servo periods becomes part of
+#: it (``ARC_BLEND_GAP_CYCLES``, default 4).
+GAP_CYCLES = 4
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -390,6 +393,7 @@ def arc_junctions(
     path_acc_mm_s2: np.ndarray,
     tol_mm: np.ndarray,
     kink_share: np.ndarray,
+    start_trim_mm: np.ndarray,
     axis_acc_mm_s2: np.ndarray,
     axis_vel_mm_s: np.ndarray,
     period_s: float,
@@ -413,6 +417,9 @@ def arc_junctions(
         Blend tolerance of each junction.
     kink_share : ndarray, shape (M - 1,)
         :math:`k` of each junction (``tpSetupTangent``).
+    start_trim_mm : ndarray, shape (M,)
+        Length the blend before each move takes off its start (a line's ``target`` is the
+        rest).
     axis_acc_mm_s2, axis_vel_mm_s : ndarray, shape (3,)
     period_s : float
 
@@ -459,7 +466,13 @@ def arc_junctions(
     start_trim[j + 1] = np.where(arc[j + 1], blend["trim2"] / moves.radius_mm[j + 1], 0.0)
     if start_trim[j].any():
         blend = arc_junction_blends(*args, sweep[j] - start_trim[j], sweep[j + 1], *rest)
-    arc_speed = np.minimum(blend["v_plan"], blend["length"] / period_s)
+    # a line's remainder passed in under GAP_CYCLES periods at the planned speed joins the
+    # blend arc before the choice (blendCheckConsume, arcFromBlendPoints3's line_length)
+    rest1 = length[j] - start_trim_mm[j] - blend["trim1"]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        consumed = ~arc[j] & blend["made"] & (rest1 < GAP_CYCLES * period_s * blend["v_plan"])
+    blend_len = blend["length"] + np.where(consumed, rest1, 0.0)
+    arc_speed = np.minimum(blend["v_plan"], blend_len / period_s)
     kink_speed = np.minimum(speed_mm_s[j], speed_mm_s[j + 1]) * KINK_RATIO / kink_share[j]
     # parabolic end (1/2), kink (1 - r_k), and 1/2 on an arc not yet finalized
     scale = 0.5 * (1.0 - KINK_RATIO)

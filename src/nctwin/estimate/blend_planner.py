@@ -124,6 +124,7 @@ from ..naivecam import merge_naive_cam
 from ..toolpath import MotionKind, PathMode, Toolpath
 from .blend_junctions import (
     ARC_BLEND,
+    GAP_CYCLES,
     KINK_RATIO,
     PARABOLIC_BLEND,
     TANGENT_BLEND,
@@ -155,9 +156,6 @@ TOLERANCE_RATIO = 0.25
 STOP_TURN_RAD = math.radians(2.0)
 #: An item runs at most at its length over this many servo periods (``TP_MIN_SEGMENT_CYCLES``).
 MIN_SEGMENT_CYCLES = 1.02
-#: A line remainder shorter than this many periods at the next arc's speed joins the arc
-#: (``ARC_BLEND_GAP_CYCLES``).
-GAP_CYCLES = 4
 #: What a stop costs beyond its trapezoids (:func:`blend_planner`'s ``stop_periods``).
 STOP_PERIODS = ("whole", "mean", "off")
 
@@ -489,9 +487,16 @@ def blend_planner(
     speed = np.minimum(feed, length / machine.period_s)
     path_acc = path_limits(moves, machine)[1]
     axis_vel = np.asarray(machine.axis_max_velocity_mm_s)
+    line_trim = np.zeros(len(moves))  # what the line-line blends take off the moves' starts
+    if candidates.any():
+        line_trim[1:] = junction_blends(
+            length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc,
+            sized_arcs=sized_arcs, stop_turn_rad=stop_turn_rad,
+        )[1]  # fmt: skip
     choice = arc_junctions(
-        moves, candidates, speed, path_acc, tol[1:], kink, axis_acc, axis_vel, machine.period_s
-    )
+        moves, candidates, speed, path_acc, tol[1:], kink, line_trim, axis_acc, axis_vel,
+        machine.period_s,
+    )  # fmt: skip
     kinked = choice["choice"] == TANGENT_BLEND
     reduce = np.where(tangent, kink, np.where(exact | kinked, KINK_RATIO, 0.0))
     kept = np.ones(len(moves))
