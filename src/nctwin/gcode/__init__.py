@@ -46,14 +46,47 @@ Anything else LinuxCNC reads (O-word subroutines and loops, ``#`` parameters, ex
 compensation, ...) raises :class:`GCodeError` with ``<construct> needs LinuxCNC's interpreter:
 run make linuxcnc``; rotary axes and codes LinuxCNC lacks are refused too. Every error of a file
 is reported, up to 20, one ``file:line: reason`` line each.
+
+Two readers
+-----------
+:func:`parse` and :func:`parse_file` take ``reader="auto"`` (default), ``"native"`` or
+``"linuxcnc"``. ``"native"`` is the reader above. ``"linuxcnc"`` runs the program through
+LinuxCNC's own rs274ngc interpreter (``make linuxcnc`` installs it; see
+:mod:`nctwin.gcode._interp`), which reads the whole language and gives the moves LinuxCNC runs,
+as the same :class:`~nctwin.toolpath.Toolpath`; it takes a LinuxCNC tool table
+(``tool_table=``, default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC
+configuration). ``"auto"`` is the native reader, and where that refuses only constructs that need
+the interpreter, the interpreter if :func:`interpreter_available`; otherwise the native error
+stands. The two agree to 1e-6 mm on every program both read (``tests/test_gcode_interp.py``).
+
+To learn which reader read a program, call :func:`read` or :func:`read_file`: they return a
+:class:`ReadResult` with ``toolpath`` and ``reader`` (``"native"`` or ``"linuxcnc"``)::
+
+    result = read_file("part.ngc")            # reader="auto"
+    result.toolpath, result.reader            # (Toolpath, "linuxcnc") for a program with O-words
 """
 
 from ._cycles import G83_RAPID_DELTA_IN as G83_RAPID_DELTA_IN
 from ._dump import dump
 from ._errors import MAX_ERRORS as MAX_ERRORS
 from ._errors import GCodeError
+from ._interp import LINUXCNC_TOOL_TABLE as LINUXCNC_TOOL_TABLE
+from ._interp import MAX_MOVES as MAX_MOVES
+from ._interp import TIMEOUT_BASE_S as TIMEOUT_BASE_S
+from ._interp import TIMEOUT_S_PER_MB as TIMEOUT_S_PER_MB
+from ._interp import interpreter_available
 from ._modal import MAX_BLOCKS_PER_LINE as MAX_BLOCKS_PER_LINE
 from ._modal import MM_PER_INCH as MM_PER_INCH
-from ._reader import parse, parse_file
+from ._select import READERS as READERS
+from ._select import ReadResult, parse, parse_file, read, read_file
 
-__all__ = ["GCodeError", "dump", "parse", "parse_file"]
+__all__ = [
+    "GCodeError",
+    "ReadResult",
+    "dump",
+    "interpreter_available",
+    "parse",
+    "parse_file",
+    "read",
+    "read_file",
+]

@@ -508,13 +508,18 @@ def _blocks(start, prev, pos, center, plane, kind, simple, turns, dwell_line, dw
 # ---------------------------------------------------------------------------------------------
 def parse_file(path: str | PathLike, **kwargs) -> Toolpath:
     """Read a program from a file (UTF-8, or Latin-1 if it is not UTF-8); see :func:`parse`."""
+    text, source = read_text(path)
+    return parse(text, source=source, **kwargs)
+
+
+def read_text(path: str | PathLike) -> tuple[str, str]:
+    """A program file's text (UTF-8, or Latin-1 if it is not UTF-8) and its name for messages."""
     p = Path(path)
     try:
         data = p.read_bytes()
     except OSError as exc:
         raise GCodeError(0, "", f"cannot read the file: {exc.strerror or exc}", str(p)) from None
     try:
-        text = data.decode("utf-8")
+        return data.decode("utf-8"), str(p)
     except UnicodeDecodeError:
-        text = data.decode("latin-1")
-    return parse(text, source=str(p), **kwargs)
+        return data.decode("latin-1"), str(p)

@@ -1,0 +1,513 @@
+"""The second reader: G-code through LinuxCNC's own rs274ngc interpreter, the whole language.
+
+Why LinuxCNC's preview module
+-----------------------------
+LinuxCNC ships two ways to run its interpreter without a machine: the stand-alone ``rs274``
+program, which prints every canonical call as text with its numbers rounded (``%.4f``), and the
+``gcode`` extension module its preview (AXIS) uses, which calls a Python object back for every
+canonical move with the source line (``next_line``) and the coordinates as full-precision
+doubles. Rounded text would put up to 5e-5 in (1.3 um) of error into every point and arc centre
+and lose the feed's digits, so this reader uses the module. It is built for the system Python
+(linuxcnc-uspace installs it for ``/usr/bin/python3``, not for nctwin's venv), so it runs in a
+child process, :file:`_linuxcnc_child.py`; the child appends every call to ``array('d')`` tables
+and writes them as raw bytes, which are read here with :func:`numpy.frombuffer` and converted with
+whole-array operations: the transport costs nothing next to the interpreter's own ~2 us per
+move (``benchmarks/interp_reader.py``).
+
+What the interpreter does and what is done here
+-----------------------------------------------
+The interpreter does the language: parameters, expressions, O-word subroutines and loops
+(subroutine files are looked up in the program's folder), canned cycles, cutter compensation,
+units, planes, offsets. Its canonical moves are turned into the same
+:class:`~nctwin.toolpath.Toolpath` the native reader makes:
+
+* Lengths: the module reports inches whatever the program's units; they are multiplied by 25.4.
+  Feeds (``set_feed_rate``, inches per minute) become mm/s.
+* Offsets are added as LinuxCNC's canon adds them (``rotate_and_offset_pos`` in emccanon.cc):
+  the G92 offset, the XY rotation (G10 L2 R), the G5x offset, the tool length offset. Work offsets
+  come from an empty parameter file (all zero), tool lengths and diameters from the tool table:
+  by default the one of nctwin's LinuxCNC configuration (:data:`LINUXCNC_TOOL_TABLE`, tool 1 of
+  diameter 0 and length 0), so that compensated paths are the ones the live LinuxCNC runs.
+* Arcs: ``arc_feed`` gives the end and centre in the plane's axis order and the signed turns;
+  an arc of T turns becomes T-1 full turns then the arc, each with its share of the helix, as
+  the native reader makes it.
+* Path control and the line of a block: the module reports modal state only in ``next_line``,
+  which it calls at the first canonical call of a line, with the state *before* that line
+  (``write_settings`` runs after a block). To see the state after every line, each line of the
+  program is given an empty comment ``(.)``, whose ``COMMENT`` call makes every executed line
+  report; the state a line's moves run in is the one the next line reports. ``settings[3:5]``
+  of the reported state are G64's P and Q (``write_settings``); the module does not name them,
+  so they are read from the object's memory, checked against ``settings[1]`` (the feed), which
+  it does name. Before the program the interpreter runs ``G64 P987654321 Q987654321``, a
+  sentinel: a block in that state is in :attr:`~nctwin.toolpath.PathMode.DEFAULT` mode, as
+  the native reader marks blocks before any G61/G64.
+* Canned cycles: LinuxCNC runs their moves in exact-path mode (but a first rapid up to R from
+  below it); the module does not report that switch, so those blocks are marked here, as the
+  native reader marks them.
+
+What differs from the native reader (by design)
+-----------------------------------------------
+* ``blend_tol_mm`` and ``naive_tol_mm`` hold what LinuxCNC uses: a G64 without P gives P = 0
+  (native: NaN), and Q defaults to P (native: NaN). :meth:`Toolpath.effective_tolerance_mm` and
+  :meth:`Toolpath.effective_naive_tol_mm` are the same for both.
+* ``events`` is empty: the module's spindle, coolant, stop and tool-select calls are empty stubs
+  that never reach Python, so M, S and T words cannot be kept.
+* Lines of blocks from a subroutine in another file are that file's lines; in such files
+  (which are not instrumented) a line's state is the one the next reporting line gives.
+* The tool starts at machine zero (LinuxCNC's preview starts there); ``start_mm`` is refused.
+
+Refused, with ``file:line: reason``: spindle-synchronised motion (G33, G33.1, G76), inverse-time
+and per-revolution feed (G93, G95), probing (G38.n), arcs outside the XY plane under an XY
+rotation, and every error LinuxCNC reports (with its message and line).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import re
+import subprocess
+import tempfile
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+
+from ..toolpath import PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
+from ._errors import GCodeError
+from ._modal import MM_PER_INCH
+
+#: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
+LINUXCNC_PYTHON = "/usr/bin/python3"
+#: The tool table of nctwin's LinuxCNC configuration (:mod:`nctwin.kernel.linuxcnc` writes this
+#: text to its instance's ``tool.tbl``): tool 1 in pocket 1, diameter 0, length 0.
+LINUXCNC_TOOL_TABLE = "T1 P1 D0 Z0 ;\n"
+#: Most canonical moves one program may make; beyond it the reader stops (endless loops).
+MAX_MOVES = 2_000_000
+#: Wall-clock limit of the interpreter: this many seconds ...
+TIMEOUT_BASE_S = 30.0
+#: ... plus this many seconds per MB of program text.
+TIMEOUT_S_PER_MB = 30.0
+#: G64 P and Q run before the program: a state with both is "nothing set" (PathMode.DEFAULT).
+PATH_SENTINEL = 987654321.0
+
+_CHILD = Path(__file__).with_name("_linuxcnc_child.py")
+_MARK = "(.)"
+_MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
+_N_MOVE, _N_EVENT, _N_MODAL = 9, 7, 12
+#: LinuxCNC's canon planes (1 XY, 2 YZ, 3 XZ) as :class:`Plane`.
+_PLANE_OF_CANON = np.array([0, Plane.XY, Plane.YZ, Plane.ZX], dtype=np.int8)
+_CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
+_SPINDLE_SYNC = {330: "G33", 331: "G33.1", 760: "G76"}
+_FEED_MODES = {930: "inverse-time feed (G93)", 950: "feed per revolution (G95)"}
+_EOF_MESSAGE = "File ended with no percent sign or program end"
+_NOT_INSTALLED = "LinuxCNC's interpreter is not installed: run make linuxcnc"
+
+
+@functools.lru_cache(maxsize=1)
+def interpreter_available() -> bool:
+    """Whether LinuxCNC's interpreter can be run here (``make linuxcnc`` installs it).
+
+    Returns
+    -------
+    bool
+        True if ``/usr/bin/python3`` imports LinuxCNC's ``gcode`` module.
+    """
+    if not os.path.exists(LINUXCNC_PYTHON):
+        return False
+    try:
+        done = subprocess.run(
+            [LINUXCNC_PYTHON, "-c", "import gcode"], capture_output=True, timeout=60
+        )
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return done.returncode == 0
+
+
+def timeout_for(n_bytes: int) -> float:
+    """The interpreter's wall-clock limit for a program of ``n_bytes`` bytes, in seconds:
+    :data:`TIMEOUT_BASE_S` plus :data:`TIMEOUT_S_PER_MB` per MB."""
+    return TIMEOUT_BASE_S + TIMEOUT_S_PER_MB * n_bytes / 1e6
+
+
+def _instrument(text: str) -> str:
+    """The program with ``(.)`` at the end of each line (before a ``;`` comment), so that every
+    line LinuxCNC executes makes a canonical call; and one more such line at the end, read when
+    the program has no M2/M30/%. Lines with ``%``, unbalanced parentheses or near LinuxCNC's
+    length limit are left as they are."""
+    lines = text.split("\n")
+    simple = (
+        ";" not in text
+        and "%" not in text
+        and text.count("(") == text.count(")")
+        and max(map(len, lines)) < _MAX_LINE
+    )
+    if simple and "\n(" not in text and not text.startswith("("):
+        body = (_MARK + "\n").join(lines) + _MARK
+    else:
+        body = "\n".join(map(_mark_line, lines))
+    return body + "\n" + _MARK + "\n"
+
+
+def _mark_line(line: str) -> str:
+    if line.lstrip().startswith("%") or len(line) >= _MAX_LINE:
+        return line
+    if line.count("(") != line.count(")") or re.search(r"\([^)]*\(", line):
+        return line  # LinuxCNC reports these itself; a mark would change its message
+    depth, cut = 0, len(line)
+    for i, ch in enumerate(line):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth -= 1
+        elif ch == ";" and depth == 0:
+            cut = i
+            break
+    return line[:cut] + _MARK + line[cut:]
+
+
+def read_linuxcnc(
+    text: str,
+    *,
+    source: str | None = None,
+    folder: str | PathLike | None = None,
+    units: str = "mm",
+    block_delete: bool = False,
+    tool_table: str | PathLike | None = None,
+    max_moves: int = MAX_MOVES,
+    timeout_s: float | None = None,
+) -> Toolpath:
+    """Read a program through LinuxCNC's interpreter.
+
+    Parameters
+    ----------
+    text : str
+        The program.
+    source : str, optional
+        File name used in error messages.
+    folder : path, optional
+        Where subroutine files (``o<name> call`` -> ``name.ngc``) are looked up: the program's
+        folder (default: the current directory).
+    units : {"mm", "inch"}
+        Units in force before the program's own G20/G21.
+    block_delete : bool
+        Whether the block-delete switch is on.
+    tool_table : path, optional
+        A LinuxCNC tool table (``.tbl``) for tool lengths (G43) and diameters (G41/G42 D);
+        default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC configuration.
+    max_moves : int
+        The reader stops with an error after this many canonical moves.
+    timeout_s : float, optional
+        Wall-clock limit; default :func:`timeout_for` the text's size. The interpreter is killed
+        when it is reached.
+
+    Returns
+    -------
+    Toolpath
+
+    Raises
+    ------
+    GCodeError
+        ``file:line: reason`` for anything LinuxCNC refuses, what this reader refuses, a limit
+        reached, or LinuxCNC missing.
+    ValueError
+        For a bad keyword argument.
+    """
+    if units not in ("mm", "inch"):
+        raise ValueError(f"units must be 'mm' or 'inch', got {units!r}")
+    if not isinstance(max_moves, int) or max_moves < 1:
+        raise ValueError(f"max_moves must be an int >= 1, got {max_moves!r}")
+    if timeout_s is None:
+        timeout_s = timeout_for(len(text.encode("utf-8", "replace")))
+    if not (isinstance(timeout_s, int | float) and 0 < timeout_s < float("inf")):
+        raise ValueError(f"timeout_s must be a finite number > 0, got {timeout_s!r}")
+    name = source or "<string>"
+    if "\0" in text:
+        line = text.count("\n", 0, text.index("\0")) + 1
+        raise GCodeError(line, "", "binary data (NUL bytes), not a G-code program", source)
+    if not interpreter_available():
+        raise GCodeError(0, "", _NOT_INSTALLED, source)
+    with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:
+        program = Path(tmp) / "program.ngc"
+        program.write_text(_instrument(text.replace("\r\n", "\n").replace("\r", "\n")))
+        table = Path(tool_table) if tool_table is not None else Path(tmp) / "tool.tbl"
+        if tool_table is None:
+            table.write_text(LINUXCNC_TOOL_TABLE)
+        elif not table.is_file():
+            raise GCodeError(0, "", f"tool table {table} not found", source)
+        job = {
+            "program": str(program),
+            "tool_table": str(table.resolve()),
+            "unitcode": "G20" if units == "inch" else "G21",
+            "initcode": f"G64 P{PATH_SENTINEL:.0f} Q{PATH_SENTINEL:.0f}",
+            "block_delete": bool(block_delete),
+            "max_moves": max_moves,
+            "deadline_s": max(timeout_s - 3.0, 0.5 * timeout_s),
+            "home": tmp,
+            "out": str(Path(tmp) / "out.bin"),
+        }
+        raw = _run_child(job, folder, timeout_s, source)
+    header, moves, events, modal = _tables(raw)
+    _raise_stop(header, source, max_moves, timeout_s, text)
+    error = header["error"]
+    if error is not None and error[1] != _EOF_MESSAGE:
+        raise GCodeError(int(error[0]), "", _reason(error[1], name, program), source)
+    return _toolpath(moves, events, modal, source)
+
+
+def _run_child(job: dict, folder, timeout_s: float, source: str | None) -> bytes:
+    """Run the child under the time limit; return its output file's bytes."""
+    env = {"PATH": "/usr/bin:/bin", "HOME": job["home"], "LANG": "C.UTF-8"}
+    cwd = str(folder) if folder is not None else None
+    try:
+        done = subprocess.run(
+            [LINUXCNC_PYTHON, "-I", str(_CHILD), json.dumps(job)],
+            capture_output=True,
+            timeout=timeout_s,
+            cwd=cwd,
+            env=env,
+        )
+    except subprocess.TimeoutExpired:
+        raise GCodeError(
+            0,
+            "",
+            f"LinuxCNC's interpreter did not finish within {timeout_s:g} s and was stopped"
+            f" (limit {TIMEOUT_BASE_S:g} s + {TIMEOUT_S_PER_MB:g} s per MB of program):"
+            " an endless loop?",
+            source,
+        ) from None
+    out = Path(job["out"])
+    if done.returncode != 0 or not out.exists():
+        tail = (done.stderr or b"").decode("utf-8", "replace").strip().splitlines()[-1:]
+        why = f"exit code {done.returncode}" + (f": {tail[0]}" if tail else "")
+        raise GCodeError(0, "", f"LinuxCNC's interpreter failed ({why})", source)
+    return out.read_bytes()
+
+
+def _tables(raw: bytes):
+    """The child's header and its three tables (moves, events, modal records)."""
+    cut = raw.index(b"\n")
+    header = json.loads(raw[:cut])
+    data = np.frombuffer(raw, dtype=np.float64, offset=cut + 1)
+    n = header["rows"]
+    moves = data[: n[0]].reshape(-1, _N_MOVE)
+    events = data[n[0] : n[0] + n[1]].reshape(-1, _N_EVENT)
+    modal = data[n[0] + n[1] :].reshape(-1, _N_MODAL)
+    return header, moves, events, modal
+
+
+def _raise_stop(header, source, max_moves, timeout_s, text) -> None:
+    """Raise the stop the child reported (a limit, a refused call, a failure), if any."""
+    stop = header["stop"]
+    if stop is None:
+        return
+    kind, line = stop[0], int(stop[1])
+    if kind == "moves":
+        reason = (
+            f"more than {max_moves} canonical moves (the limit, max_moves): an endless"
+            " O-word loop? LinuxCNC's interpreter was stopped here"
+        )
+    elif kind == "time":
+        reason = (
+            f"LinuxCNC's interpreter was stopped here after {timeout_s:g} s, the time limit"
+            f" ({TIMEOUT_BASE_S:g} s + {TIMEOUT_S_PER_MB:g} s per MB of program): an endless"
+            " O-word loop?"
+        )
+    elif kind == "refused":
+        reason = f"{stop[2]}: not read (its path depends on the spindle or a probe)"
+    else:
+        reason = f"LinuxCNC's interpreter failed: {stop[2]}"
+    raise GCodeError(line, "", reason, source)
+
+
+def _reason(message: str, name: str, program: Path) -> str:
+    """LinuxCNC's message, with the instrumented copy's name replaced by the program's."""
+    message = message.replace(str(program), name).replace(program.name, name)
+    bad = re.match(r"Bad character '([abcuvw])' used", message)
+    if bad:
+        message += (
+            f": the {bad.group(1).upper()} axis is not on this machine (nctwin's LinuxCNC"
+            " machines have the axes X, Y and Z only)"
+        )
+    return message
+
+
+# ---------------------------------------------------------------------------------------------
+# Canonical moves -> Toolpath
+# ---------------------------------------------------------------------------------------------
+def _after_states(events: np.ndarray) -> np.ndarray:
+    """The state each event's moves run in: the one the next event reports (see the module
+    docstring), the last event's own for the last one. Shape (E, 7)."""
+    if not len(events):
+        return events
+    return np.vstack([events[1:], events[-1:]])
+
+
+def _path_control(after: np.ndarray):
+    """Path mode, P and Q (mm) per event from the after-states.
+
+    At a change of units the interpreter re-reads P and Q from the canon
+    (``convert_length_units``), where LinuxCNC's keeps them in machine units, so they stay the
+    same length; the preview module answers a constant 0.1 instead. A state whose units changed
+    with P = Q = 0.1 keeps the previous state's P and Q (so ``G20 G64 P0.1`` on one line is read
+    as ``G20``, the one case this cannot tell apart).
+    """
+    code, units = after[:, 1], after[:, 4]
+    raw = after[:, 1:5]
+    start = np.r_[True, (raw[1:] != raw[:-1]).any(axis=1)]  # runs of one state
+    new_units = np.r_[False, units[1:] != units[:-1]]
+    reread = new_units & (after[:, 2] == 0.1) & (after[:, 3] == 0.1)
+    reread = reread[np.flatnonzero(start)][np.cumsum(start) - 1]  # the whole run
+    keep = np.maximum.accumulate(np.where(reread, 0, np.arange(len(code))))
+    tol, naive = after[keep, 2], after[keep, 3]
+    default = (code == 640) & (tol == PATH_SENTINEL) & (naive == PATH_SENTINEL)
+    mode = np.select(
+        [default, code == 640, code == 610, code == 611],
+        [PathMode.DEFAULT, PathMode.BLEND, PathMode.EXACT_PATH, PathMode.EXACT_STOP],
+        PathMode.DEFAULT,
+    ).astype(np.int8)
+    # P and Q stay in the units of the G64 that set them: those in force where they changed
+    key = np.stack([code, tol, naive], axis=1)
+    changed = np.r_[True, (key[1:] != key[:-1]).any(axis=1)]
+    idx = np.maximum.accumulate(np.where(changed, keep, 0))
+    scale = np.where(units[idx] == 200, MM_PER_INCH, 1.0)
+    blend = mode == PathMode.BLEND
+    return mode, np.where(blend, tol * scale, np.nan), np.where(blend, naive * scale, np.nan)
+
+
+def _refuse_modes(kind, ev, after, lines, source) -> None:
+    """Spindle-synchronised motion and feed modes other than G94 cannot be a Toolpath."""
+    motion, feed_mode = after[ev, 6], after[ev, 5]
+    moving = kind != 4
+    bad = moving & np.isin(motion, list(_SPINDLE_SYNC))
+    if bad.any():
+        k = int(np.argmax(bad))
+        code = _SPINDLE_SYNC[int(motion[k])]
+        raise GCodeError(
+            int(lines[k]), "", f"{code} is spindle-synchronised motion: not read", source
+        )
+    bad = moving & (kind != 0) & np.isin(feed_mode, list(_FEED_MODES))
+    if bad.any():
+        k = int(np.argmax(bad))
+        what = _FEED_MODES[int(feed_mode[k])]
+        raise GCodeError(
+            int(lines[k]), "", f"{what} is not read: a Toolpath's feeds are mm/s", source
+        )
+
+
+def _toolpath(moves, events, modal, source) -> Toolpath:
+    """The canonical moves as a Toolpath (mm, mm/s, machine coordinates)."""
+    if not len(moves):
+        return Toolpath.empty()
+    kind = moves[:, 0].astype(np.int8)
+    ev = moves[:, 1].astype(np.int64)
+    mod = modal[moves[:, 2].astype(np.int64)]
+    after = _after_states(events)
+    lines = events[ev, 0].astype(np.int64)
+    _refuse_modes(kind, ev, after, lines, source)
+    n = len(moves)
+    arc = kind == 2
+    plane = _PLANE_OF_CANON[mod[:, 1].astype(np.int64)]
+    rot_deg = mod[:, 11]
+    if (arc & (plane != Plane.XY) & (rot_deg != 0)).any():
+        k = int(np.argmax(arc & (plane != Plane.XY) & (rot_deg != 0)))
+        raise GCodeError(
+            int(lines[k]), "", "an arc outside the XY plane under an XY rotation (G10 L2 R)"
+            " is not a Toolpath arc: not read", source,
+        )  # fmt: skip
+
+    # points in program coordinates (in): lines as given, arcs from their plane's order
+    end = moves[:, 3:6].copy()
+    center = np.full((n, 3), np.nan)
+    ai = np.flatnonzero(arc)
+    ax = PLANE_AXES[plane[ai]]
+    end[ai[:, None], ax] = moves[ai][:, 3:6]
+    center[ai, ax[:, 0]] = moves[ai, 6]
+    center[ai, ax[:, 1]] = moves[ai, 7]
+
+    # machine coordinates as LinuxCNC's canon makes them, then mm
+    def to_machine(p):
+        q = p + mod[:, 2:5]
+        t = np.deg2rad(rot_deg)
+        x, y = q[:, 0].copy(), q[:, 1].copy()
+        turned = rot_deg != 0
+        q[turned, 0] = (x * np.cos(t) - y * np.sin(t))[turned]
+        q[turned, 1] = (x * np.sin(t) + y * np.cos(t))[turned]
+        return (q + mod[:, 5:8] + mod[:, 8:11]) * MM_PER_INCH
+
+    dwell = kind == 4
+    end = to_machine(end)
+    center = to_machine(center)
+    # a dwell stays where the previous move ended; the tool starts at machine zero
+    last = np.where(dwell, -1, np.arange(n))
+    np.maximum.accumulate(last, out=last)
+    end = np.where((last >= 0)[:, None], end[np.maximum(last, 0)], 0.0)
+    start = np.vstack([np.zeros(3), end[:-1]])
+    center[ai, ax[:, 2]] = start[ai, ax[:, 2]]
+    out_kind = np.where(
+        arc, np.where(moves[:, 8] > 0, MotionKind.ARC_CCW, MotionKind.ARC_CW), kind
+    ).astype(np.int8)
+    turns = np.where(arc, np.abs(moves[:, 8]), 1).astype(np.int64)
+    mode, blend, naive = _path_control(after)
+    mode, blend, naive = mode[ev], blend[ev], naive[ev]
+    exact = _cycle_exact(kind, ev, after, start, end, plane)
+    mode[exact], blend[exact], naive[exact] = PathMode.EXACT_PATH, np.nan, np.nan
+    fields = {
+        "start_mm": start,
+        "end_mm": end,
+        "kind": out_kind,
+        "feed_mm_s": mod[:, 0] * MM_PER_INCH / 60.0,
+        "center_mm": center,
+        "plane": plane,
+        "dwell_s": np.where(dwell, moves[:, 3], 0.0),
+        "line": lines,
+        "path_mode": mode,
+        "blend_tol_mm": blend,
+        "naive_tol_mm": naive,
+    }
+    if (turns > 1).any():
+        fields = _expand_turns(fields, turns)
+    return Toolpath(**fields)
+
+
+def _cycle_exact(kind, ev, after, start, end, plane) -> np.ndarray:
+    """Moves of canned cycles, which LinuxCNC runs in exact-path mode: all but a first rapid
+    straight up to R, made before the switch (``convert_cycle``)."""
+    cycle = np.isin(after[ev, 6], _CYCLES) & (kind != 4)
+    if not cycle.any():
+        return cycle
+    first = np.r_[True, ev[1:] != ev[:-1]]
+    ax = PLANE_AXES[plane]
+    rows = np.arange(len(kind))
+    d = end - start
+    up = (kind == 0) & (d[rows, ax[:, 0]] == 0) & (d[rows, ax[:, 1]] == 0) & (d[rows, ax[:, 2]] > 0)
+    return cycle & ~(first & up)
+
+
+def _expand_turns(f: dict, turns: np.ndarray) -> dict:
+    """An arc of T turns as T-1 full turns then the arc, each with its share of the travel
+    along the plane's normal (as the native reader reads ``G2/G3 P``)."""
+    rep = np.repeat(np.arange(len(turns)), turns)
+    j = np.arange(len(rep)) - np.repeat(np.cumsum(turns) - turns, turns)  # turn of each row
+    out = {k: v[rep].copy() for k, v in f.items()}
+    multi = np.flatnonzero(turns[rep] > 1)
+    i, jm = rep[multi], j[multi]
+    s, e, c, pl = f["start_mm"][i], f["end_mm"][i], f["center_mm"][i], f["plane"][i]
+    ccw = f["kind"][i] == MotionKind.ARC_CCW
+    ax = PLANE_AXES[pl]
+    r = np.arange(len(i))
+    sweep = np.abs(arc_sweep(s, e, c, pl, ccw))
+    t = turns[i]
+    share = 2.0 * np.pi / (sweep + 2.0 * np.pi * (t - 1))
+    sn = s[r, ax[:, 2]]
+    dn = e[r, ax[:, 2]] - sn
+    inner = jm < t - 1
+    new_end = np.where(inner[:, None], s, e)
+    new_end[r, ax[:, 2]] = np.where(inner, sn + dn * share * (jm + 1), e[r, ax[:, 2]])
+    new_start = s.copy()
+    new_start[r, ax[:, 2]] = sn + dn * share * jm
+    c = c.copy()
+    c[r, ax[:, 2]] = new_start[r, ax[:, 2]]
+    out["start_mm"][multi], out["end_mm"][multi], out["center_mm"][multi] = new_start, new_end, c
+    return out

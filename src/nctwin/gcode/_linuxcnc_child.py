@@ -1,0 +1,237 @@
+"""The child process of :mod:`nctwin.gcode._interp`: runs one program through LinuxCNC's
+rs274ngc interpreter (its preview module ``gcode``) and writes what the canon reported.
+
+This file is not imported by nctwin: ``/usr/bin/python3`` (the Python LinuxCNC's module is built
+for) runs it as a script, with one argument, a JSON object:
+
+``program``
+    The program file (already instrumented by the parent: every line ends in ``()``).
+``tool_table``
+    A LinuxCNC tool table (``.tbl``), loaded as LinuxCNC's ``iocontrol`` loads it.
+``unitcode``, ``initcode``
+    What the interpreter runs before the program (``G21``/``G20``; the path-mode sentinel).
+``block_delete``
+    The block-delete switch.
+``max_moves``, ``deadline_s``
+    Limits: canonical moves, and seconds of wall-clock time (checked when LinuxCNC asks).
+``home``, ``out``
+    A private folder (LinuxCNC's tool data are shared through ``$HOME/.tool.mmap``) and the file
+    the results go to.
+
+The output file holds a JSON header line, then three tables of float64 rows as raw bytes:
+
+* moves, 9 columns: kind (0 rapid, 1 feed, 2 arc, 4 dwell), event, modal record, then for lines
+  ``x y z``, for arcs ``first_end second_end axis_end first_centre second_centre rotation``, for
+  dwells the time in ``x``; zeros elsewhere. Lengths in inches, as the module reports them.
+* events, 7 columns, one per ``next_line``: line, path mode, G64 P, G64 Q (program units),
+  units (200/210), feed mode, motion mode; the state the interpreter had when the line began.
+* modal records, 12 columns: feed (in/min, NaN before the first F), canon plane (1 XY, 2 YZ,
+  3 XZ), G92 offset (3), G5x offset (3), tool length offset (3), XY rotation (degrees).
+"""
+
+import array
+import ctypes
+import json
+import math
+import os
+import struct
+import sys
+import time
+
+#: Offset of ``settings[]`` in a ``gcode.linecode`` object: after ob_refcnt and ob_type.
+_SETTINGS_OFFSET = 2 * ctypes.sizeof(ctypes.c_void_p)
+
+
+class _Tool(ctypes.Structure):
+    """LinuxCNC's ``CANON_TOOL_TABLE`` (emctool.h)."""
+
+    _fields_ = [
+        ("toolno", ctypes.c_int),
+        ("pocketno", ctypes.c_int),
+        ("offset", ctypes.c_double * 9),
+        ("diameter", ctypes.c_double),
+        ("frontangle", ctypes.c_double),
+        ("backangle", ctypes.c_double),
+        ("orientation", ctypes.c_int),
+    ]
+
+
+class _Stop(Exception):
+    """Raised inside a canon call to stop the interpreter; the reason is kept on the canon."""
+
+
+class _Tools:
+    """LinuxCNC's tool data (libtooldata): a fresh memory map loaded from the tool table, as
+    ``iocontrol`` makes it; the interpreter finds tools in it by number."""
+
+    def __init__(self, path):
+        lib = ctypes.CDLL("libtooldata.so.0")
+        creator = lib._Z17tool_mmap_creatorPK13EMC_TOOL_STATi
+        creator.argtypes = [ctypes.c_void_p, ctypes.c_int]
+        load = lib._Z13tooldata_loadPKcPPc
+        load.argtypes = [ctypes.c_char_p, ctypes.c_void_p]
+        self._get = lib._Z12tooldata_getP16CANON_TOOL_TABLEi
+        self._get.argtypes = [ctypes.POINTER(_Tool), ctypes.c_int]
+        creator(None, 0)  # a non-random tool changer, as nctwin's LinuxCNC configuration
+        if load(path.encode(), None) != 0:
+            raise OSError(f"cannot read the tool table {path}")
+
+    def get(self, index):
+        t = _Tool()
+        if self._get(ctypes.byref(t), index) != 0:
+            return (-1,) + (0.0,) * 12 + (0,)
+        return (t.toolno, *t.offset, t.diameter, t.frontangle, t.backangle, t.orientation)
+
+
+class Canon:
+    """The callbacks of LinuxCNC's preview module: every move, dwell and state change is
+    appended to flat ``array('d')`` tables."""
+
+    def __init__(self, job, tools):
+        self.parameter_file = os.path.join(job["home"], "rs274ngc.var")
+        self.tools, self.block_delete = tools, bool(job["block_delete"])
+        self.max_rows = 9 * int(job["max_moves"])
+        self.deadline = time.monotonic() + float(job["deadline_s"])
+        self.moves, self.events, self.modal = array.array("d"), array.array("d"), array.array("d")
+        self.ev = -1.0
+        self.line = 0
+        self.stop = None
+        self.state = [math.nan, 1.0] + [0.0] * 10
+        self._push()
+
+    # ---- state
+    def _push(self):
+        self.modal.extend(self.state)
+        self.mod = float(len(self.modal) // 12 - 1)
+
+    def next_line(self, st):
+        feed, _, tol, naive = struct.unpack_from(
+            "dddd", ctypes.string_at(id(st) + _SETTINGS_OFFSET, 40), 8
+        )
+        if feed != st.feed_rate:  # settings[] is not where this layout says: stop, never guess
+            self.stop = ["internal", self.line, "unknown layout of gcode.linecode"]
+            raise _Stop()
+        self.line = st.sequence_number
+        self.events.extend(
+            (self.line, st.path_mode, tol, naive, st.units, st.feed_mode, st.motion_mode)
+        )
+        self.ev += 1.0
+
+    def set_feed_rate(self, rate):
+        self.state[0] = rate
+        self._push()
+
+    def set_plane(self, plane):
+        self.state[1] = plane
+        self._push()
+
+    def set_g92_offset(self, x, y, z, *rest):
+        self.state[2:5] = [x, y, z]
+        self._push()
+
+    def set_g5x_offset(self, index, x, y, z, *rest):
+        self.state[5:8] = [x, y, z]
+        self._push()
+
+    def tool_offset(self, x, y, z, *rest):
+        self.state[8:11] = [x, y, z]
+        self._push()
+
+    def set_xy_rotation(self, degrees):
+        self.state[11] = degrees
+        self._push()
+
+    # ---- motion
+    def _full(self):
+        if len(self.moves) >= self.max_rows:
+            self.stop = ["moves", self.line]
+            raise _Stop()
+
+    def straight_traverse(self, x, y, z, *rest):
+        self.moves.extend((0.0, self.ev, self.mod, x, y, z, 0.0, 0.0, 0.0))
+        if len(self.moves) >= self.max_rows:
+            self._full()
+
+    def straight_feed(self, x, y, z, *rest):
+        self.moves.extend((1.0, self.ev, self.mod, x, y, z, 0.0, 0.0, 0.0))
+        if len(self.moves) >= self.max_rows:
+            self._full()
+
+    def arc_feed(self, e1, e2, c1, c2, rotation, e3, *rest):
+        self.moves.extend((2.0, self.ev, self.mod, e1, e2, e3, c1, c2, float(rotation)))
+        if len(self.moves) >= self.max_rows:
+            self._full()
+
+    def dwell(self, seconds):
+        self.moves.extend((4.0, self.ev, self.mod, seconds, 0.0, 0.0, 0.0, 0.0, 0.0))
+
+    def rigid_tap(self, *args):
+        self.stop = ["refused", self.line, "rigid tapping (G33.1) is spindle-synchronised motion"]
+        raise _Stop()
+
+    def straight_probe(self, *args):
+        self.stop = ["refused", self.line, "probing (G38.n) has no tool path without a probe"]
+        raise _Stop()
+
+    # ---- questions the interpreter asks
+    def get_external_length_units(self):
+        return 1.0  # machine units: mm, as nctwin's LinuxCNC configuration (LINEAR_UNITS = mm)
+
+    def get_external_angular_units(self):
+        return 1.0
+
+    def get_axis_mask(self):
+        return 7  # X, Y, Z
+
+    def get_block_delete(self):
+        return self.block_delete
+
+    def get_tool(self, index):
+        return self.tools.get(index)
+
+    def check_abort(self):
+        if time.monotonic() > self.deadline:
+            self.stop = ["time", self.line]
+            return True
+        return False
+
+    def __getattr__(self, name):  # comments, messages, tool changes, ...: nothing to keep
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return _ignore
+
+
+def _ignore(*args):
+    return None
+
+
+def main():
+    job = json.loads(sys.argv[1])
+    os.environ["HOME"] = job["home"]  # where libtooldata puts .tool.mmap
+    header = {"error": None, "stop": None}
+    canon = None
+    try:
+        import gcode
+
+        canon = Canon(job, _Tools(job["tool_table"]))
+        open(canon.parameter_file, "w").close()
+        result, line = gcode.parse(job["program"], canon, job["unitcode"], job["initcode"])
+        if result > gcode.MIN_ERROR:
+            header["error"] = [line, gcode.strerror(result)]
+    except BaseException as exc:  # a stop raised in a callback arrives as LinuxCNC's error
+        if canon is None or canon.stop is None:
+            line = canon.line if canon else 0
+            header["stop"] = ["internal", line, f"{type(exc).__name__}: {exc}"]
+    if canon is not None and canon.stop is not None:
+        header["stop"] = canon.stop
+    tables = (canon.moves, canon.events, canon.modal) if canon else ((), (), ())
+    header["rows"] = [len(t) for t in tables]
+    with open(job["out"], "wb") as f:
+        f.write(json.dumps(header).encode() + b"\n")
+        for t in tables:
+            if len(t):
+                t.tofile(f)
+
+
+if __name__ == "__main__":
+    main()
