@@ -529,8 +529,12 @@ def blend_planner(
     halved[1:] |= para
     if para.any():
         feed, acc = move_limits(moves, machine, kept * np.where(halved, TANGENTIAL_ACC_RATIO, 1.0))
+        # each move as long as the blends at its other ends leave it (its target)
+        d_end, d_start = (np.where(para, 0.0, x) for x in (d_end, d_start))
+        target = length - np.concatenate([[0.0], d_start]) - np.concatenate([d_end, [0.0]])
+        target = np.maximum(target, 1e-9)
         speed = parabolic_blend_speeds(
-            length, feed, acc, moves.end_tangents, moves.start_tangents, tol
+            target, feed, acc, moves.end_tangents, moves.start_tangents, tol
         )
         v = np.where(para, speed, v)
     v = np.where(tangent, np.minimum(feed[:-1], feed[1:]), v)
