@@ -158,7 +158,8 @@ def test_exact_stop_at_corner():
 #: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), a rapid followed
 #: by a feed move (no blend between them), a corner of short moves before a long line (the
 #: lazy look-ahead's dip), slow reversals whose blend arcs are as small as their speed allows,
-#: and G61 chords of a circle that LinuxCNC passes as tangent (R 500 mm) or stops at (R 20 mm).
+#: G61 chords of a circle that LinuxCNC passes as tangent (R 500 mm) or stops at (R 20 mm), and
+#: small kinks next to a programmed arc (nctwin.estimate.blend_junctions).
 PLANNER_PROGRAMS = {
     "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
@@ -203,6 +204,21 @@ PLANNER_PROGRAMS = {
         for k in range(1, 101)
     )
     + "M2\n",
+    # an arc into a 0.126 mm line that turns 1 degree towards its centre: the blend arc as
+    # LinuxCNC makes it is 0.004 mm long, passed at 4 mm/s (its length per servo period)
+    "arc_kink_xy": "G21 G90 G64 P0.0254 Q0\nG0 X-5 Y5\nG1 F12000\nG17 G3 X0 Y0 I5 J0\n"
+    "G1 X0.126 Y0.0022\nX10.1123 Y0.5256\nM2\n",
+    "arc_kink_yz": "G21 G90 G64 P0.0254 Q0\nG0 Y-5 Z5\nG1 F12000\nG19 G3 Y0 Z0 J5 K0\n"
+    "G1 Y0.126 Z0.0022\nY10.1123 Z0.5256\nM2\n",
+    # a 0.5 degree kink into an arc: the 0.004 mm blend arc alone is slower than the kink speed,
+    # but the line's rest it consumes makes it faster (blendCheckConsume before the choice)
+    "line_kink_arc": "G21 G90 G64 P0.0254 Q0\nG0 X10.1226 Y0.2629\nG1 F12000\n"
+    "X0.126 Y0.0011\nX0 Y0\nG17 G2 X-5 Y5 I0 J5\nM2\n",
+    # two arcs with a 3.2 degree kink, and an arc into a last line with a 6 degree kink
+    "arc_kink_arc": "G21 G90 G64 P0.0254 Q0\nG0 X-5 Y5\nG1 F12000\nG17 G3 X0 Y0 I5 J0\n"
+    "G2 X5.2713 Y-4.7131 I0.2791 J-4.9922\nG1 Y-14.7131\nM2\n",
+    "arc_kink_last": "G21 G90 G64 P0.0254 Q0\nG0 Y-5 Z5\nG1 F12000\nG19 G3 Y0 Z0 J5 K0\n"
+    "G1 Y9.9452 Z1.0453\nM2\n",
     "g61_stops": "G21 G90 G61\nG1 F1800\n"
     + "".join(
         f"X{20 * math.sin(k / 20):.4f} Y{20 - 20 * math.cos(k / 20):.4f}\n" for k in range(1, 11)
