@@ -464,8 +464,14 @@ def arc_junctions(
     # an arc shortened at its start by the blend before it keeps the rest of its sweep
     start_trim = np.zeros(m)
     start_trim[j + 1] = np.where(arc[j + 1], blend["trim2"] / moves.radius_mm[j + 1], 0.0)
-    if start_trim[j].any():
-        blend = arc_junction_blends(*args, sweep[j] - start_trim[j], sweep[j + 1], *rest)
+    again = np.flatnonzero(start_trim[j] > 0)
+    if len(again):
+        sub = arc_junction_blends(
+            *(a[again] for a in args), (sweep[j] - start_trim[j])[again], sweep[j + 1][again],
+            *(a[again] for a in rest),
+        )  # fmt: skip
+        for key, value in sub.items():
+            blend[key][again] = value
     # a line's remainder passed in under GAP_CYCLES periods at the planned speed joins the
     # blend arc before the choice (blendCheckConsume, arcFromBlendPoints3's line_length)
     rest1 = length[j] - start_trim_mm[j] - blend["trim1"]
