@@ -64,6 +64,7 @@ rotation, and every error LinuxCNC reports (with its message and line).
 from __future__ import annotations
 
 import functools
+import itertools
 import json
 import os
 import re
@@ -95,7 +96,7 @@ PATH_SENTINEL = 987654321.0
 _CHILD = Path(__file__).with_name("_linuxcnc_child.py")
 _MARK = "(.)"
 _MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
-_N_MOVE, _N_EVENT, _N_MODAL = 9, 7, 12
+_N_MOVE, _N_MODAL = 7, 13
 #: LinuxCNC's canon planes (1 XY, 2 YZ, 3 XZ) as :class:`Plane`.
 _PLANE_OF_CANON = np.array([0, Plane.XY, Plane.YZ, Plane.ZX], dtype=np.int8)
 _CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
@@ -249,11 +250,24 @@ def read_linuxcnc(
         }
         raw = _run_child(job, folder, timeout_s, source)
     header, moves, events, modal = _tables(raw)
-    _raise_stop(header, source, max_moves, timeout_s, text)
+    _raise_stop(header, events, source, max_moves, timeout_s)
     error = header["error"]
     if error is not None and error[1] != _EOF_MESSAGE:
-        raise GCodeError(int(error[0]), "", _reason(error[1], name, program), source)
+        raise GCodeError(
+            _error_line(error, events), "", _reason(error[1], name, program, folder), source
+        )
     return _toolpath(moves, events, modal, source)
+
+
+def _error_line(error: list, events: np.ndarray) -> int:
+    """The line of LinuxCNC's error. The module returns its last reported line, plus one for an
+    error in reading a line, after reporting the line the interpreter stopped on (the read
+    error's line too): that last report is the line. A missing subroutine is searched for to
+    the end of the file; its message names the line of the call."""
+    called = re.search(r"from line: (\d+)", error[1])
+    if called:
+        return int(called.group(1))
+    return int(events[-1, 1]) if len(events) else int(error[0])
 
 
 def _run_child(job: dict, folder, timeout_s: float, source: str | None) -> bytes:
@@ -286,23 +300,47 @@ def _run_child(job: dict, folder, timeout_s: float, source: str | None) -> bytes
 
 
 def _tables(raw: bytes):
-    """The child's header and its three tables (moves, events, modal records)."""
+    """The child's header and its tables: moves (M, 7), events (E, 8: the moves before each, then
+    line, path mode, P, Q, units, feed mode, motion mode) and modal records (K, 13)."""
     cut = raw.index(b"\n")
     header = json.loads(raw[:cut])
-    data = np.frombuffer(raw, dtype=np.float64, offset=cut + 1)
-    n = header["rows"]
-    moves = data[: n[0]].reshape(-1, _N_MOVE)
-    events = data[n[0] : n[0] + n[1]].reshape(-1, _N_EVENT)
-    modal = data[n[0] + n[1] :].reshape(-1, _N_MODAL)
+    sizes = header["bytes"]
+    if not sizes:
+        return header, np.zeros((0, _N_MOVE)), np.zeros((0, 8)), np.zeros((0, _N_MODAL))
+    bounds = np.cumsum([cut + 1, *sizes])
+    view = memoryview(raw)  # no copies: the arrays are views of the child's bytes
+    part = [view[a:b] for a, b in itertools.pairwise(bounds)]
+    moves = np.frombuffer(part[0], np.float64).reshape(-1, _N_MOVE)
+    n_g, n_m = header["codes"] or (0, 0)
+    state = np.dtype([("settings", "<f8", 5), ("gcodes", "<i4", n_g), ("mcodes", "<i4", n_m)])
+    st = np.frombuffer(part[2], state)
+    g = st["gcodes"].reshape(len(st), n_g)
+    events = (
+        np.column_stack(
+            [
+                np.frombuffer(part[1], np.float64),
+                g[:, 0],  # line
+                g[:, 11],  # path mode
+                st["settings"][:, 3:5],  # G64 P, Q
+                g[:, 5],  # units
+                g[:, 7],  # feed mode
+                g[:, 1],  # motion mode
+            ]
+        )
+        if len(st)
+        else np.zeros((0, 8))
+    )
+    modal = np.frombuffer(part[3], np.float64).reshape(-1, _N_MODAL)
     return header, moves, events, modal
 
 
-def _raise_stop(header, source, max_moves, timeout_s, text) -> None:
-    """Raise the stop the child reported (a limit, a refused call, a failure), if any."""
+def _raise_stop(header, events, source, max_moves, timeout_s) -> None:
+    """Raise the stop the child reported (a limit, a refused call, a failure), if any, at the
+    last line LinuxCNC reported."""
     stop = header["stop"]
     if stop is None:
         return
-    kind, line = stop[0], int(stop[1])
+    kind, line = stop[0], int(events[-1, 1]) if len(events) else 0
     if kind == "moves":
         reason = (
             f"more than {max_moves} canonical moves (the limit, max_moves): an endless"
@@ -310,20 +348,28 @@ def _raise_stop(header, source, max_moves, timeout_s, text) -> None:
         )
     elif kind == "time":
         reason = (
-            f"LinuxCNC's interpreter was stopped here after {timeout_s:g} s, the time limit"
-            f" ({TIMEOUT_BASE_S:g} s + {TIMEOUT_S_PER_MB:g} s per MB of program): an endless"
-            " O-word loop?"
+            f"LinuxCNC's interpreter reached its time limit of {timeout_s:g} s"
+            f" ({TIMEOUT_BASE_S:g} s + {TIMEOUT_S_PER_MB:g} s per MB of program) and was"
+            " stopped after this line: an endless O-word loop?"
         )
     elif kind == "refused":
-        reason = f"{stop[2]}: not read (its path depends on the spindle or a probe)"
+        reason = f"{stop[1]}: not read (its path depends on the spindle or a probe)"
     else:
-        reason = f"LinuxCNC's interpreter failed: {stop[2]}"
+        reason = f"LinuxCNC's interpreter failed: {stop[1]}"
     raise GCodeError(line, "", reason, source)
 
 
-def _reason(message: str, name: str, program: Path) -> str:
-    """LinuxCNC's message, with the instrumented copy's name replaced by the program's."""
+def _reason(message: str, name: str, program: Path, folder) -> str:
+    """LinuxCNC's message, with the instrumented copy's name replaced by the program's, and
+    what it means where it is terse."""
     message = message.replace(str(program), name).replace(program.name, name)
+    sub = re.search(r"seeking o-word: o<([^>]*)>", message)
+    if sub:
+        where = Path(folder) if folder is not None else Path.cwd()
+        message = (
+            f"subroutine o<{sub.group(1)}> not found: no file {sub.group(1)}.ngc in {where}"
+            f" and no o<{sub.group(1)}> sub in the program (LinuxCNC: {message})"
+        )
     bad = re.match(r"Bad character '([abcuvw])' used", message)
     if bad:
         message += (
@@ -401,8 +447,12 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     if not len(moves):
         return Toolpath.empty()
     kind = moves[:, 0].astype(np.int8)
-    ev = moves[:, 1].astype(np.int64)
-    mod = modal[moves[:, 2].astype(np.int64)]
+    index = np.arange(len(moves))
+    # the event and modal record of each move: the last one made before it
+    # (the child counts the moves made before an event as float64 values, 7 per move)
+    ev = np.searchsorted(events[:, 0] / _N_MOVE, index, side="right") - 1
+    mod = modal[np.searchsorted(modal[:, 0] / _N_MOVE, index, side="right") - 1, 1:]
+    events = events[:, 1:]
     after = _after_states(events)
     lines = events[ev, 0].astype(np.int64)
     _refuse_modes(kind, ev, after, lines, source)
@@ -418,13 +468,13 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
         )  # fmt: skip
 
     # points in program coordinates (in): lines as given, arcs from their plane's order
-    end = moves[:, 3:6].copy()
+    end = moves[:, 1:4].copy()
     center = np.full((n, 3), np.nan)
     ai = np.flatnonzero(arc)
     ax = PLANE_AXES[plane[ai]]
-    end[ai[:, None], ax] = moves[ai][:, 3:6]
-    center[ai, ax[:, 0]] = moves[ai, 6]
-    center[ai, ax[:, 1]] = moves[ai, 7]
+    end[ai[:, None], ax] = moves[ai][:, 1:4]
+    center[ai, ax[:, 0]] = moves[ai, 4]
+    center[ai, ax[:, 1]] = moves[ai, 5]
 
     # machine coordinates as LinuxCNC's canon makes them, then mm
     def to_machine(p):
@@ -446,9 +496,9 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     start = np.vstack([np.zeros(3), end[:-1]])
     center[ai, ax[:, 2]] = start[ai, ax[:, 2]]
     out_kind = np.where(
-        arc, np.where(moves[:, 8] > 0, MotionKind.ARC_CCW, MotionKind.ARC_CW), kind
+        arc, np.where(moves[:, 6] > 0, MotionKind.ARC_CCW, MotionKind.ARC_CW), kind
     ).astype(np.int8)
-    turns = np.where(arc, np.abs(moves[:, 8]), 1).astype(np.int64)
+    turns = np.where(arc, np.abs(moves[:, 6]), 1).astype(np.int64)
     mode, blend, naive = _path_control(after)
     mode, blend, naive = mode[ev], blend[ev], naive[ev]
     exact = _cycle_exact(kind, ev, after, start, end, plane)
@@ -460,7 +510,7 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
         "feed_mm_s": mod[:, 0] * MM_PER_INCH / 60.0,
         "center_mm": center,
         "plane": plane,
-        "dwell_s": np.where(dwell, moves[:, 3], 0.0),
+        "dwell_s": np.where(dwell, moves[:, 1], 0.0),
         "line": lines,
         "path_mode": mode,
         "blend_tol_mm": blend,

@@ -18,15 +18,20 @@ for) runs it as a script, with one argument, a JSON object:
     A private folder (LinuxCNC's tool data are shared through ``$HOME/.tool.mmap``) and the file
     the results go to.
 
-The output file holds a JSON header line, then three tables of float64 rows as raw bytes:
+The output file holds a JSON header line, then the tables as raw bytes, in this order:
 
-* moves, 9 columns: kind (0 rapid, 1 feed, 2 arc, 4 dwell), event, modal record, then for lines
-  ``x y z``, for arcs ``first_end second_end axis_end first_centre second_centre rotation``, for
-  dwells the time in ``x``; zeros elsewhere. Lengths in inches, as the module reports them.
-* events, 7 columns, one per ``next_line``: line, path mode, G64 P, G64 Q (program units),
-  units (200/210), feed mode, motion mode; the state the interpreter had when the line began.
-* modal records, 12 columns: feed (in/min, NaN before the first F), canon plane (1 XY, 2 YZ,
-  3 XZ), G92 offset (3), G5x offset (3), tool length offset (3), XY rotation (degrees).
+* moves, float64, 7 columns: kind (0 rapid, 1 feed, 2 arc, 4 dwell), then for lines ``x y z``,
+  for arcs ``first_end second_end axis_end first_centre second_centre rotation``, for dwells the
+  time in the first column; zeros elsewhere. Lengths in inches, as the module reports them.
+* events (one per ``next_line``): the moves made before it (float64), then the reported state
+  itself, the ``settings`` (5 float64) and ``gcodes``/``mcodes`` (int32) arrays of the
+  ``gcode.linecode`` object, copied from its memory (the header gives their lengths).
+* modal records, float64, 13 columns: the moves made before it, feed (in/min, NaN before the
+  first F), canon plane (1 XY, 2 YZ, 3 XZ), G92 offset (3), G5x offset (3), tool length offset
+  (3), XY rotation (degrees).
+
+The callbacks are closures over local tables, not methods: they run once per move, and a
+closure's names cost less than attribute look-ups.
 """
 
 import array
@@ -84,38 +89,76 @@ class _Tools:
 
 
 class Canon:
-    """The callbacks of LinuxCNC's preview module: every move, dwell and state change is
-    appended to flat ``array('d')`` tables."""
+    """The callbacks of LinuxCNC's preview module: every move, dwell, state change and line is
+    appended to flat tables."""
 
     def __init__(self, job, tools):
         self.parameter_file = os.path.join(job["home"], "rs274ngc.var")
         self.tools, self.block_delete = tools, bool(job["block_delete"])
-        self.max_rows = 9 * int(job["max_moves"])
         self.deadline = time.monotonic() + float(job["deadline_s"])
-        self.moves, self.events, self.modal = array.array("d"), array.array("d"), array.array("d")
-        self.ev = -1.0
-        self.line = 0
+        self.moves, self.modal = array.array("d"), array.array("d")
+        self.event_at, self.states = array.array("d"), bytearray()
         self.stop = None
+        self.n_codes = None
         self.state = [math.nan, 1.0] + [0.0] * 10
+        self._bind(int(job["max_moves"]) * 7)
         self._push()
+
+    def _bind(self, max_rows):
+        """The per-move callbacks, as closures."""
+        moves, add = self.moves, self.moves.extend
+
+        def full():
+            if len(moves) >= max_rows:
+                self.stop = ["moves"]
+                raise _Stop()
+
+        def straight_traverse(x, y, z, *rest):
+            add((0.0, x, y, z, 0.0, 0.0, 0.0))
+            if len(moves) >= max_rows:
+                full()
+
+        def straight_feed(x, y, z, *rest):
+            add((1.0, x, y, z, 0.0, 0.0, 0.0))
+            if len(moves) >= max_rows:
+                full()
+
+        def arc_feed(e1, e2, c1, c2, rotation, e3, *rest):
+            add((2.0, e1, e2, e3, c1, c2, float(rotation)))
+            if len(moves) >= max_rows:
+                full()
+
+        def dwell(seconds):
+            add((4.0, seconds, 0.0, 0.0, 0.0, 0.0, 0.0))
+
+        at, states, string_at, n_moves = self.event_at.append, self.states, ctypes.string_at, len
+
+        def next_line(st):
+            at(n_moves(moves))
+            states.extend(string_at(id(st) + _SETTINGS_OFFSET, size))
+
+        def first_next_line(st):
+            nonlocal size
+            self.n_codes = [len(st.gcodes), len(st.mcodes)]
+            size = 40 + 4 * sum(self.n_codes)
+            raw = ctypes.string_at(id(st) + _SETTINGS_OFFSET, size)
+            settings = struct.unpack_from("5d", raw)
+            gcodes = struct.unpack_from(f"{self.n_codes[0]}i", raw, 40)
+            named = (st.feed_rate, st.sequence_number, st.motion_mode, st.units, st.path_mode)
+            if named != (settings[1], gcodes[0], gcodes[1], gcodes[5], gcodes[11]):
+                self.stop = ["internal", "unknown layout of gcode.linecode"]
+                raise _Stop()  # never guess at memory
+            self.next_line = next_line
+            next_line(st)
+
+        size = 0
+        self.straight_traverse, self.straight_feed = straight_traverse, straight_feed
+        self.arc_feed, self.dwell, self.next_line = arc_feed, dwell, first_next_line
 
     # ---- state
     def _push(self):
+        self.modal.append(len(self.moves))
         self.modal.extend(self.state)
-        self.mod = float(len(self.modal) // 12 - 1)
-
-    def next_line(self, st):
-        feed, _, tol, naive = struct.unpack_from(
-            "dddd", ctypes.string_at(id(st) + _SETTINGS_OFFSET, 40), 8
-        )
-        if feed != st.feed_rate:  # settings[] is not where this layout says: stop, never guess
-            self.stop = ["internal", self.line, "unknown layout of gcode.linecode"]
-            raise _Stop()
-        self.line = st.sequence_number
-        self.events.extend(
-            (self.line, st.path_mode, tol, naive, st.units, st.feed_mode, st.motion_mode)
-        )
-        self.ev += 1.0
 
     def set_feed_rate(self, rate):
         self.state[0] = rate
@@ -141,36 +184,15 @@ class Canon:
         self.state[11] = degrees
         self._push()
 
-    # ---- motion
-    def _full(self):
-        if len(self.moves) >= self.max_rows:
-            self.stop = ["moves", self.line]
-            raise _Stop()
-
-    def straight_traverse(self, x, y, z, *rest):
-        self.moves.extend((0.0, self.ev, self.mod, x, y, z, 0.0, 0.0, 0.0))
-        if len(self.moves) >= self.max_rows:
-            self._full()
-
-    def straight_feed(self, x, y, z, *rest):
-        self.moves.extend((1.0, self.ev, self.mod, x, y, z, 0.0, 0.0, 0.0))
-        if len(self.moves) >= self.max_rows:
-            self._full()
-
-    def arc_feed(self, e1, e2, c1, c2, rotation, e3, *rest):
-        self.moves.extend((2.0, self.ev, self.mod, e1, e2, e3, c1, c2, float(rotation)))
-        if len(self.moves) >= self.max_rows:
-            self._full()
-
-    def dwell(self, seconds):
-        self.moves.extend((4.0, self.ev, self.mod, seconds, 0.0, 0.0, 0.0, 0.0, 0.0))
+    def comment(self, text):  # every line has one (the parent's mark): nothing to keep
+        return None
 
     def rigid_tap(self, *args):
-        self.stop = ["refused", self.line, "rigid tapping (G33.1) is spindle-synchronised motion"]
+        self.stop = ["refused", "rigid tapping (G33.1) is spindle-synchronised motion"]
         raise _Stop()
 
     def straight_probe(self, *args):
-        self.stop = ["refused", self.line, "probing (G38.n) has no tool path without a probe"]
+        self.stop = ["refused", "probing (G38.n) has no tool path without a probe"]
         raise _Stop()
 
     # ---- questions the interpreter asks
@@ -191,11 +213,11 @@ class Canon:
 
     def check_abort(self):
         if time.monotonic() > self.deadline:
-            self.stop = ["time", self.line]
+            self.stop = ["time"]
             return True
         return False
 
-    def __getattr__(self, name):  # comments, messages, tool changes, ...: nothing to keep
+    def __getattr__(self, name):  # messages, tool changes, ...: nothing to keep
         if name.startswith("__"):
             raise AttributeError(name)
         return _ignore
@@ -220,17 +242,18 @@ def main():
             header["error"] = [line, gcode.strerror(result)]
     except BaseException as exc:  # a stop raised in a callback arrives as LinuxCNC's error
         if canon is None or canon.stop is None:
-            line = canon.line if canon else 0
-            header["stop"] = ["internal", line, f"{type(exc).__name__}: {exc}"]
-    if canon is not None and canon.stop is not None:
-        header["stop"] = canon.stop
-    tables = (canon.moves, canon.events, canon.modal) if canon else ((), (), ())
-    header["rows"] = [len(t) for t in tables]
+            header["stop"] = ["internal", f"{type(exc).__name__}: {exc}"]
+    if canon is None:
+        tables = ()
+    else:
+        header["stop"] = canon.stop or header["stop"]
+        header["codes"] = canon.n_codes
+        tables = (canon.moves, canon.event_at, canon.states, canon.modal)
+    header["bytes"] = [len(memoryview(t).cast("B")) for t in tables]
     with open(job["out"], "wb") as f:
         f.write(json.dumps(header).encode() + b"\n")
         for t in tables:
-            if len(t):
-                t.tofile(f)
+            f.write(t)
 
 
 if __name__ == "__main__":
