@@ -55,6 +55,9 @@ What differs from the native reader (by design)
 * Lines of blocks from a subroutine in another file are that file's lines; in such files
   (which are not instrumented) a line's state is the one the next reporting line gives.
 * The tool starts at machine zero (LinuxCNC's preview starts there); ``start_mm`` is refused.
+* G94 sets LinuxCNC's feed to 0 (``convert_feed_mode``): the blocks after it carry NaN (no feed
+  set) up to the next F, and a feed move there is LinuxCNC's error; the native reader keeps the
+  F in force across a G94.
 
 Refused, with ``file:line: reason``: spindle-synchronised motion (G33, G33.1, G76), inverse-time
 and per-revolution feed (G93, G95), probing (G38.n), arcs outside the XY plane under an XY
@@ -94,6 +97,9 @@ TIMEOUT_S_PER_MB = 30.0
 PATH_SENTINEL = 987654321.0
 
 _CHILD = Path(__file__).with_name("_linuxcnc_child.py")
+#: The child stops itself (naming its last line) this long before the time limit (or at half of
+#: it): LinuxCNC lets it check about every 2 s, and it is killed at the limit if it has not.
+_CHILD_MARGIN_S = 2.5
 _MARK = "(.)"
 _MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
 _N_MOVE, _N_MODAL = 7, 13
@@ -244,7 +250,7 @@ def read_linuxcnc(
             "initcode": f"G64 P{PATH_SENTINEL:.0f} Q{PATH_SENTINEL:.0f}",
             "block_delete": bool(block_delete),
             "max_moves": max_moves,
-            "deadline_s": max(timeout_s - 3.0, 0.5 * timeout_s),
+            "deadline_s": max(timeout_s - _CHILD_MARGIN_S, 0.5 * timeout_s),
             "home": tmp,
             "out": str(Path(tmp) / "out.bin"),
         }
@@ -507,7 +513,9 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
         "start_mm": start,
         "end_mm": end,
         "kind": out_kind,
-        "feed_mm_s": mod[:, 0] * MM_PER_INCH / 60.0,
+        # G94 sets LinuxCNC's feed to 0 (convert_feed_mode), at which only rapids and dwells
+        # run: the Toolpath's "no feed set", NaN
+        "feed_mm_s": np.where(mod[:, 0] == 0, np.nan, mod[:, 0] * MM_PER_INCH / 60.0),
         "center_mm": center,
         "plane": plane,
         "dwell_s": np.where(dwell, moves[:, 1], 0.0),
@@ -522,17 +530,27 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
 
 
 def _cycle_exact(kind, ev, after, start, end, plane) -> np.ndarray:
-    """Moves of canned cycles, which LinuxCNC runs in exact-path mode: all but a first rapid
-    straight up to R, made before the switch (``convert_cycle``)."""
-    cycle = np.isin(after[ev, 6], _CYCLES) & (kind != 4)
+    """Moves and dwells of canned cycles, which LinuxCNC runs in exact-path mode: all but a first
+    rapid straight to R from below it, made before the switch (``convert_cycle``).
+
+    That rapid keeps the tool's place in the plane, and the move after it is the rapid over the
+    hole at R's height. Without it, a first move that keeps the place in the plane (the hole
+    straight below) is followed by a rapid down to R or by a feed; the one exception, a G87 back
+    boring cycle under the tool with the tool exactly at R, is taken as the rapid to R.
+    """
+    cycle = np.isin(after[ev, 6], _CYCLES)
     if not cycle.any():
         return cycle
     first = np.r_[True, ev[1:] != ev[:-1]]
     ax = PLANE_AXES[plane]
     rows = np.arange(len(kind))
     d = end - start
-    up = (kind == 0) & (d[rows, ax[:, 0]] == 0) & (d[rows, ax[:, 1]] == 0) & (d[rows, ax[:, 2]] > 0)
-    return cycle & ~(first & up)
+    eps = 1e-9  # mm: the interpreter's position and the canon's differ by rounding
+    still = (np.abs(d[rows, ax[:, 0]]) <= eps) & (np.abs(d[rows, ax[:, 1]]) <= eps)
+    level_rapid = (kind == 0) & (np.abs(d[rows, ax[:, 2]]) <= eps)
+    next_level_rapid = np.r_[level_rapid[1:] & ~first[1:], False]
+    pre = first & (kind == 0) & still & next_level_rapid
+    return cycle & ~pre
 
 
 def _expand_turns(f: dict, turns: np.ndarray) -> dict:
