@@ -8,11 +8,12 @@ from types import SimpleNamespace
 import numpy as np
 import pandas as pd
 import pytest
+import torch
 
 from nctwin.chapters import denkena2020 as dk
 from nctwin.chapters.denkena2020_bench import _segment
 from nctwin.physics import drives
-from nctwin.report.tables import load_paper_table
+from nctwin.report.tables import Claim, load_paper_table
 
 GRID = {k: sorted(g["value"].astype(float))
         for k, g in load_paper_table("denkena2020_table1").groupby("parameter")}  # fmt: skip
@@ -103,3 +104,45 @@ def test_two_sided_band_claims() -> None:
     assert claims["reversal_model_worse"].value == 15.0
     assert claims["pocket_model_worse"].value == 20.0
     assert claims["worst_lstm_semi_stable"].holds
+
+
+def test_claims_by_seed_reads_every_seed_beside_the_ensemble() -> None:
+    def claims(lower: float, pocket: float) -> list:
+        return [Claim("lower", "reduction", lower, ">=", 10.0),
+                Claim("pocket", "pocket", pocket, ">", 0.0)]  # fmt: skip
+
+    table = dk.claims_by_seed(claims(20.0, 1.0), {3: claims(5.0, 2.0), 4: claims(30.0, -1.0),
+                                                  5: claims(25.0, 3.0)})  # fmt: skip
+    row = table.set_index("id").loc["lower"]
+    assert (row.ensemble, row.holds, row.seed_3, row.seed_4, row.seed_5) == (20.0, True, 5, 30, 25)
+    assert (row.seed_min, row.seed_max, row.seeds_holding) == (5.0, 30.0, 2)
+    assert row.seed_std == pytest.approx(np.std([5.0, 30.0, 25.0], ddof=1))
+    assert table.set_index("id").loc["pocket", "seeds_holding"] == 2
+
+
+def test_seeds_train_in_parallel_with_the_sequential_bits(tmp_path, monkeypatch) -> None:
+    from joblib.externals.loky import get_reusable_executor
+
+    rng = np.random.default_rng(0)
+    procs = [SimpleNamespace(test=i == 5) for i in range(6)]
+    rec = SimpleNamespace(processes=procs, inputs=rng.normal(0.0, 1.0, (6, 300, 14)))
+    targets = rng.normal(0.0, 50.0, (6, 300, 3))
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "sequential"))
+    one, _ = dk.train_lstms(rec, targets, [0, 1], max_epochs=2, n_jobs=1)
+    # fresh workers that see a fresh cache: the networks are trained there, not loaded
+    get_reusable_executor().shutdown(wait=True)
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "parallel"))
+    try:
+        two, _ = dk.train_lstms(rec, targets, [0, 1], max_epochs=2, n_jobs=2)
+    finally:
+        get_reusable_executor().shutdown(wait=True)
+    assert len(list((tmp_path / "parallel").rglob("*.pt"))) == 4
+    for s in (0, 1):
+        assert list(one[s]) == list(two[s]) == ["X", "Y"]
+        for axis in "XY":
+            a, b = one[s][axis], two[s][axis]
+            assert a.train_config.seed == s and a.history == b.history
+            for k, v in a.model.state_dict().items():
+                assert torch.equal(v, b.model.state_dict()[k]), (s, axis, k)
+    # the seeds differ, the axes differ
+    assert not torch.equal(one[0]["X"].model.head.weight, one[1]["X"].model.head.weight)

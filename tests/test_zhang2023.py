@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -10,6 +12,7 @@ import pytest
 import torch
 
 from nctwin.chapters import zhang2023 as zh
+from nctwin.chapters import zhang2023_seeds as zs
 from nctwin.learn.models import BPConfig, build_bp
 from nctwin.learn.train import Scaler, TrainConfig, Trained
 from nctwin.report.tables import load_paper_table
@@ -63,9 +66,12 @@ def test_paper_configs_batches() -> None:
     model, full = zh.paper_configs(325)
     assert model.dropout == 0.5 and model.weight_init == "normal"
     assert full.learning_rate == 1e-5 and full.momentum == 0.8 and full.max_epochs == 2000
-    assert full.patience == full.max_epochs  # no early stop: the paper's 2000 epochs
+    # early stopping, the paper's 2000 epochs as the cap
+    assert full.patience == zh.PAPER_PATIENCE == 100
     _, one = zh.paper_configs(325, batch_rows=1, dropout=0.0, epochs=1)
-    assert (one.window_lines, one.batch_size, one.max_epochs) == (1, 1, 1)
+    assert (one.window_lines, one.batch_size, one.max_epochs, one.patience) == (1, 1, 1, 1)
+    _, short = zh.paper_configs(325, batch_rows=32, epochs=20)
+    assert short.patience == short.max_epochs == 20  # a short sweep keeps every epoch
     with pytest.raises(ValueError, match="batch_rows"):
         zh.paper_configs(325, batch_rows=0)
 
@@ -108,3 +114,62 @@ def test_folded_prediction_is_the_networks_prediction() -> None:
     np.testing.assert_allclose(pred, by_hand, rtol=0, atol=1e-5)
     with pytest.raises(ValueError, match="shape"):
         zh.predict_um(net, x[:, :12])
+
+
+def _tiny_surface(seed: int) -> SimpleNamespace:
+    """What zh.train reads of a surface: samples x and targets y_um (n, 1)."""
+    rng = np.random.default_rng(seed)
+    x = rng.normal(0.0, 1.0, (400, 7))
+    return SimpleNamespace(x=x, y_um=(x[:, :1] ** 2 + 0.1 * x[:, 1:2]))
+
+
+def test_parallel_training_gives_the_sequential_bits(tmp_path, monkeypatch) -> None:
+    from joblib.externals.loky import get_reusable_executor
+
+    from nctwin.runner import run_tasks
+
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "sequential"))
+    data, rows = _tiny_surface(0), np.arange(400)
+    args = [(data, rows, *zh.variant_configs(7, epochs=3, seed=s), f"tiny{s}") for s in (0, 1)]
+    one = [zs._train_or_none(*a) for a in args]
+    # fresh workers that see a fresh cache: the networks are trained there, not loaded
+    get_reusable_executor().shutdown(wait=True)
+    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "parallel"))
+    try:
+        two = run_tasks(zs._call, [(zs._train_or_none, a) for a in args], n_jobs=2)
+    finally:
+        get_reusable_executor().shutdown(wait=True)
+    assert len(list((tmp_path / "parallel").rglob("*.pt"))) == 2
+    for a, b in zip(one, two, strict=True):
+        assert a.history == b.history and a.best_epoch == b.best_epoch
+        for (k, va), (_, vb) in zip(a.model.state_dict().items(), b.model.state_dict().items(),
+                                    strict=True):  # fmt: skip
+            assert torch.equal(va, vb), k
+
+
+def _run(pct: float, pred: list[float]) -> zh.TransferRun:
+    return zh.TransferRun(2, pct, None, np.arange(len(pred)), np.array(pred))
+
+
+def test_ensemble_transfer_is_the_mean_per_share() -> None:
+    chains = [[_run(0.0, [1.0, 2.0]), _run(15.0, [3.0, 5.0])],
+              [_run(0.0, [3.0, 4.0]), _run(15.0, [1.0, 1.0])]]  # fmt: skip
+    runs = zs.ensemble_transfer(chains)
+    assert [r.finetune_pct for r in runs] == [0.0, 15.0]
+    np.testing.assert_array_equal(runs[0].predicted_um, [2.0, 3.0])
+    np.testing.assert_array_equal(runs[1].predicted_um, [2.0, 3.0])
+
+
+def test_seed_runs_score_each_seed_and_their_mean() -> None:
+    rng = np.random.default_rng(1)
+    x = rng.normal(0.0, 1.0, (50, 13))
+    y = rng.uniform(0.0, 3.0, (50, 1))
+    record = {"history": {"train": [2.0, 1.0], "val": [2.0, 1.0]}, "best_epoch": 2}
+    nets = [replace(_network(x, y), **record), replace(_network(x, 2.0 * y), **record)]
+    table = zs.seed_runs({"n": nets}, x, y[:, 0], 2.0)
+    assert list(table.seed) == [0, 0, -1]  # both untrained networks carry the default seed
+    assert list(table.epochs[:2]) == [2, 2] and table.converged[:2].all()
+    mean = 0.5 * (zh.predict_um(nets[0], x) + zh.predict_um(nets[1], x))
+    ens = table.iloc[-1]
+    assert ens.test_mse == pytest.approx(np.mean(((mean - y[:, 0]) / 2.0) ** 2))
+    assert ens.max_abs_err_um == pytest.approx(np.abs(mean - y[:, 0]).max())

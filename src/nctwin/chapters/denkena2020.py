@@ -10,19 +10,23 @@ The chapter's pipeline, kept out of the notebook:
    interpolates each process, computes its milling forces and runs the drives.
 3. :func:`fit_force_model` fits the paper's model (:mod:`nctwin.methods.denkena2020`) on the air
    moves in its four steps.
-4. :func:`train_lstms` trains one stacked LSTM per force component with the shared loop;
-   :func:`table2` and :func:`summary` score both methods.
+4. :func:`train_lstms` trains one stacked LSTM per force component and seed with the shared loop,
+   in parallel; :func:`table2` and :func:`summary` score both methods, the LSTM by the mean of
+   the seeds' predictions, and :func:`seed_table` and :func:`claims_by_seed` give the spread.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pandas as pd
 
-from ..learn.train import TrainConfig, Trained, fit
+from ..learn.train import TrainConfig, Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
 from ..report.tables import Claim, side_by_side
+from .chien2023 import fit_seeds
 from .denkena2020_bench import (
     DIRECTIONS,
     TOOL,
@@ -34,6 +38,7 @@ from .denkena2020_bench import (
     run_air_moves,
     run_processes,
 )
+from .denkena2020_figures import band_coverage, figure_cases, plot_cases
 
 __all__ = [
     "DIRECTIONS",
@@ -44,6 +49,7 @@ __all__ = [
     "Windows",
     "band_coverage",
     "claims",
+    "claims_by_seed",
     "design_processes",
     "figure_cases",
     "fit_force_model",
@@ -278,44 +284,49 @@ def train_config(seed: int = 0, max_epochs: int = 200) -> TrainConfig:
 def train_lstms(
     recorded: Recorded,
     targets: np.ndarray,
-    train_config: TrainConfig,
+    seeds: Sequence[int],
     *,
+    max_epochs: int = 200,
     axes: str = "XY",
-    progress: bool = True,
-) -> tuple[dict[str, Trained], fm.InputScaling]:
-    """One network per force component on the training processes (:func:`nctwin.learn.train.fit`).
+    n_jobs: int = 2,
+) -> tuple[dict[int, dict[str, Trained]], fm.InputScaling]:
+    """One network per force component and seed on the training processes, all of them in
+    parallel (:func:`nctwin.chapters.chien2023.fit_seeds`: one task per network and seed through
+    :func:`nctwin.runner.run_tasks`, one torch thread each, so the same bits as one after the
+    other; each cached by :func:`nctwin.learn.train.fit` as ``denkena2020_<axis>_seed<s>``).
 
     Parameters
     ----------
     recorded : Recorded
     targets : ndarray, shape (P, R, 3)
         Filtered forces (:func:`target_forces`).
-    train_config : TrainConfig
+    seeds : sequence of int
+        Training seeds (initial weights, validation split, window offsets, batch order,
+        dropout masks); the data and the scaling are the same for every seed.
+    max_epochs : int
+        Safety cap of :func:`train_config`.
     axes : str
         Components trained (the paper scores X and Y).
-    progress : bool
+    n_jobs : int
+        Parallel trainings.
 
     Returns
     -------
     dict
-        ``{"X": Trained, "Y": ...}``.
+        ``{seed: {"X": Trained, "Y": ...}}``, in the order of ``seeds``.
     InputScaling
     """
     train = np.array([not p.test for p in recorded.processes])
     scaling = fm.InputScaling.fit(recorded.inputs[train], targets[train])
     xs = [scaling.inputs(x) for x in recorded.inputs[train]]
-    nets = {}
+    jobs = {}
     for axis in axes:
         i = "XYZ".index(axis)
         ys = [scaling.force(y[:, [i]], i) for y in targets[train]]
-        nets[axis] = fit(
-            fm.MODEL_CONFIG,
-            train_config,
-            xs,
-            ys,
-            name=f"denkena2020_{axis.lower()}_s{train_config.seed}",
-            progress=progress,
-        )
+        jobs[axis] = (fm.MODEL_CONFIG, train_config(seeds[0], max_epochs), xs, ys)
+    out = fit_seeds({f"denkena2020_{a.lower()}": job for a, job in jobs.items()}, seeds,
+                    n_jobs=n_jobs)  # fmt: skip
+    nets = {s: {a: out[f"denkena2020_{a.lower()}"][k] for a in axes} for k, s in enumerate(seeds)}
     return nets, scaling
 
 
@@ -464,7 +475,9 @@ def summary(table: pd.DataFrame, paper: pd.DataFrame) -> pd.DataFrame:
 def seed_table(
     tables: dict[int, pd.DataFrame], nets: dict[int, dict[str, Trained]]
 ) -> pd.DataFrame:
-    """One row per seed: its networks' best and last epochs and its own cutting-window scores.
+    """One row per seed: its networks' best and last epochs, whether early stopping ended them
+    (``converged_*``: the best epoch lies more than ``patience`` epochs below the cap, as in
+    :func:`nctwin.chapters.chien2023.convergence`), and its own cutting-window scores.
 
     Parameters
     ----------
@@ -473,13 +486,47 @@ def seed_table(
     nets : dict
         Seed -> ``{"X": Trained, ...}``.
     """
+
+    def converged(n: Trained) -> bool:
+        return n.best_epoch < n.train_config.max_epochs - n.train_config.patience
+
     return pd.DataFrame([
         {"seed": s, **{f"best_epoch_{a}": n.best_epoch for a, n in nets[s].items()},
          **{f"epochs_{a}": len(n.history["train"]) for a, n in nets[s].items()},
+         **{f"converged_{a}": converged(n) for a, n in nets[s].items()},
          "mean_lstm_rmse_n": t["lstm_cutting_rmse_n"].mean(),
          "lstm_lower_pct": _lower_pct(t, "cutting_")}
         for s, t in tables.items()
     ])  # fmt: skip
+
+
+def claims_by_seed(ensemble: list[Claim], per_seed: dict[int, list[Claim]]) -> pd.DataFrame:
+    """Each claim's value and verdict for the ensemble (the rule) beside every seed's own.
+
+    Parameters
+    ----------
+    ensemble : list of Claim
+        :func:`claims` of the mean of the seeds' predictions.
+    per_seed : dict
+        Seed -> :func:`claims` of that seed's networks alone.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per claim: ``id``, ``op``, ``threshold``, ``ensemble`` (value), ``holds``,
+        ``seed_<s>`` (each seed's value), ``seed_min``, ``seed_max``, ``seed_std`` (sample
+        standard deviation) and ``seeds_holding`` (how many seeds' own claims hold).
+    """
+    rows = []
+    for k, c in enumerate(ensemble):
+        values = np.array([per_seed[s][k].value for s in per_seed], dtype=float)
+        by_seed = {f"seed_{s}": v for s, v in zip(per_seed, values, strict=True)}
+        rows.append({"id": c.id, "op": c.op, "threshold": c.threshold, "ensemble": c.value,
+                     "holds": c.holds, **by_seed,
+                     "seed_min": values.min(), "seed_max": values.max(),
+                     "seed_std": values.std(ddof=1) if len(values) > 1 else np.nan,
+                     "seeds_holding": sum(per_seed[s][k].holds for s in per_seed)})  # fmt: skip
+    return pd.DataFrame(rows)
 
 
 def kind_means(table: pd.DataFrame, paper2: pd.DataFrame) -> pd.DataFrame:
@@ -510,129 +557,6 @@ def kind_means(table: pd.DataFrame, paper2: pd.DataFrame) -> pd.DataFrame:
     ours_kind = pd.concat([ours_kind, semi], ignore_index=True)
     paper_rows = paper2.assign(process=paper2["process"].replace({"side milling": "semi-stable"}))
     return side_by_side(ours_kind, paper_rows, on=["process", "axis"], columns=cols)
-
-
-def _pick(table: pd.DataFrame, processes: list[Process], kind: str, **kw) -> int:
-    """Index of the test process of the first row of ``table`` of ``kind`` (and the column
-    values ``kw``)."""
-    rows = table[(table["process"] == kind)]
-    for k, v in kw.items():
-        rows = rows[rows[k] == v]
-    key = rows.iloc[0]
-    return next(p.index for p in processes if p.test and p.vf_mm_min == key.vf_mm_min
-                and p.n_rpm == key.n_rpm and p.ae_mm == key.ae_mm and p.ap_mm == key.ap_mm
-                and p.feed_direction == key.feed_direction)  # fmt: skip
-
-
-def figure_cases(table: pd.DataFrame, processes: list[Process]) -> dict[str, int]:
-    """The test processes of the Figs. 4-9 analogues: a diagonal cut, a circular pocket, the
-    semi-stable process with the largest LSTM RMSE and a ramp.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        :func:`table2`.
-    processes : list of Process
-
-    Returns
-    -------
-    dict
-        Figure title -> process index.
-    """
-    diag = table[table["feed_direction"].str.len() == 4]
-    return {
-        "diagonal cut (Figs. 4-5)": _pick(table, processes, diag.iloc[0]["process"],
-                                          feed_direction=diag.iloc[0]["feed_direction"]),
-        "circular pocket (Figs. 6-7)": _pick(table, processes, "circular pocket"),
-        "semi-stable (Fig. 8)": _pick(
-            table, processes,
-            table.loc[table[table["semi_stable"]]["lstm_cutting_nrmse"].idxmax(), "process"],
-            semi_stable=True,
-        ),
-        "ramp -y/+z (Fig. 9)": _pick(table, processes, "ramp milling"),
-    }  # fmt: skip
-
-
-def plot_cases(
-    cases: dict[str, int],
-    t_s: np.ndarray,
-    targets: np.ndarray,
-    recon: dict[int, np.ndarray],
-    lstm: dict[int, np.ndarray],
-    bands: dict[int, np.ndarray],
-):
-    """Measured (filtered) force, the model and the LSTM with its MC-dropout band (mean
-    +- 1.96 standard deviations), X and Y, one row per case; only draws.
-
-    Parameters
-    ----------
-    cases : dict
-        Title -> process index (:func:`figure_cases`).
-    t_s : ndarray, shape (R,)
-        Sample times.
-    targets : ndarray, shape (P, R, 3)
-        Filtered measured forces.
-    recon, lstm : dict
-        Process index -> forces (R, 3) of the model and of the LSTM.
-    bands : dict
-        Process index -> MC-dropout forces (samples, R, 2) of X and Y.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(len(cases), 2, figsize=(11, 2.6 * len(cases)),
-                             constrained_layout=True, sharex=True)  # fmt: skip
-    for row, (title, i) in zip(axes, cases.items(), strict=True):
-        mean, std = bands[i].mean(axis=0), bands[i].std(axis=0)
-        for ax, name in zip(row, "XY", strict=True):
-            j = "XYZ".index(name)
-            t = t_s
-            ax.plot(t, targets[i, :, j], "k", lw=0.8, label="measured, 120 Hz")
-            ax.plot(t, recon[i][:, j], lw=0.7, label="model")
-            ax.plot(t, lstm[i][:, j], lw=0.8, label="LSTM")
-            ax.fill_between(t, mean[:, j] - 1.96 * std[:, j], mean[:, j] + 1.96 * std[:, j],
-                            alpha=0.3, color="C1", lw=0, label="MC dropout 95 %")  # fmt: skip
-            ax.set_title(f"{title}: F{name.lower()}", fontsize=9)
-            ax.set_ylabel("force (N)")
-    axes[0, 0].legend(frameon=False, fontsize=7, ncol=2)
-    for ax in axes[-1]:
-        ax.set_xlabel("time (s)")
-    return fig
-
-
-def band_coverage(
-    targets: np.ndarray, bands: dict[int, np.ndarray], test: list[int]
-) -> pd.DataFrame:
-    """Empirical coverage of the MC-dropout band (mean +- 1.96 standard deviations) on the test
-    processes, X and Y.
-
-    Parameters
-    ----------
-    targets : ndarray, shape (P, R, 3)
-        Filtered measured forces.
-    bands : dict
-        Process index -> MC-dropout forces (samples, R, 2) of X and Y.
-    test : list of int
-        The test processes.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per axis: ``axis``, ``coverage_pct`` (share of test samples inside the band) and
-        ``mean_band_halfwidth_n``.
-    """
-    return pd.DataFrame([
-        {"axis": name,
-         "coverage_pct": 100.0 * np.mean(np.concatenate([
-             np.abs(targets[i, :, j] - bands[i][..., j].mean(axis=0))
-             <= 1.96 * bands[i][..., j].std(axis=0) for i in test])),
-         "mean_band_halfwidth_n": float(np.mean([1.96 * bands[i][..., j].std(axis=0).mean()
-                                                 for i in test]))}
-        for j, name in enumerate("XY")
-    ])  # fmt: skip
 
 
 def claims(

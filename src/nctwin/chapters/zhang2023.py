@@ -19,14 +19,18 @@ Configurations
 --------------
 :func:`paper_configs`
     The paper's settings: weights N(0, 1), dropout 0.5, SGD with momentum 0.8, lr 1e-5,
-    2000 epochs, MSE. The paper gives no batch size (its SGD reads as one random sample per
-    update); the default is the full batch, and :func:`batch_sweep` runs 1, 32, 256 rows and
+    2000 epochs as the cap with early stopping after :data:`PAPER_PATIENCE` epochs without
+    improvement, MSE. The paper gives no batch size (its SGD reads as one random sample per
+    update); the default is the full batch, and :func:`batch_sweep` scores 1, 32, 256 rows and
     the full batch, with and without dropout.
 :func:`variant_configs`
     The closest variant that converges here: PyTorch's default uniform weights, SGD with
     momentum 0.8, lr 1e-2, batches of 128 rows, ``epochs`` epochs, MSE, dropout as given.
 :func:`finetune_configs`
     Fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr 1e-3.
+
+Every network of the chapter is trained by :func:`nctwin.chapters.zhang2023_seeds.train_networks`
+(five seeds of those the claims judge, in parallel); this module scores them.
 """
 
 from __future__ import annotations
@@ -42,13 +46,16 @@ import torch
 
 from ..checks import best_time_s
 from ..learn.models import BPConfig
-from ..learn.train import TrainConfig, Trained, TrainingDivergedError, fit, load_checkpoint
+from ..learn.train import TrainConfig, Trained, fit, load_checkpoint
 from ..physics.steperror import step_error_iterative_um, step_error_samples, step_error_um
 from ..report.tables import Claim
 from .zhang2023_surfaces import HIDDEN, SurfaceData, chord_check, surface_data, surfaces_table
+from .zhang2023_tables import dropout_conventions, error_histogram, transfer_metrics
 
 __all__ = [
+    "BATCH_RUNS",
     "HIDDEN",
+    "PAPER_PATIENCE",
     "SurfaceData",
     "TransferRun",
     "batch_sweep",
@@ -72,6 +79,11 @@ __all__ = [
     "transfer_table",
     "variant_configs",
 ]
+
+
+#: Early stopping of the paper's settings: epochs without a lower validation loss before
+#: training stops (the paper's 2000 epochs are the cap).
+PAPER_PATIENCE = 100
 
 
 def split(n: int, share: float, *, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -110,7 +122,9 @@ def paper_configs(
     batch_rows : int, optional
         Rows per update; None: all training rows (one update per epoch).
     epochs : int
-        Paper: 2000 (no early stopping: patience = epochs).
+        Paper: 2000, the cap; training stops earlier once the validation loss has not improved
+        for :data:`PAPER_PATIENCE` epochs (the kept weights, those of the best validation
+        epoch, are then the same as after all ``epochs``).
 
     Raises
     ------
@@ -124,8 +138,9 @@ def paper_configs(
     model = BPConfig(n_inputs=n_inputs, hidden=HIDDEN, dropout=dropout, weight_init="normal")
     window, batch = (99, 1_000_000) if batch_rows is None else (batch_rows, 1)
     train_config = TrainConfig(
-        seed=seed, max_epochs=epochs, patience=epochs, batch_size=batch, window_lines=window,
-        learning_rate=1e-5, val_share=0.1, loss="mse", optimiser="sgd", momentum=0.8,
+        seed=seed, max_epochs=epochs, patience=min(epochs, PAPER_PATIENCE), batch_size=batch,
+        window_lines=window, learning_rate=1e-5, val_share=0.1, loss="mse", optimiser="sgd",
+        momentum=0.8,
     )  # fmt: skip
     return model, train_config
 
@@ -234,99 +249,56 @@ def scaled_mse(trained: Trained, x: np.ndarray, y_um: np.ndarray) -> float:
 
 
 def dropout_sweep(
-    data: SurfaceData,
-    train_rows: np.ndarray,
-    test_rows: np.ndarray,
-    probabilities: tuple[float, ...],
-    *,
-    epochs: int,
-    seed: int,
-    progress: bool = True,
+    data: SurfaceData, test_rows: np.ndarray, nets: dict[float, Trained | None]
 ) -> pd.DataFrame:
-    """Table 2: the variant trained with each dropout probability.
+    """Table 2: the variant trained with each dropout probability (:func:`train_networks`).
 
     Returns
     -------
     DataFrame
         ``dropout_p``, ``final_train_mse`` (last epoch, dropout active), ``test_mse`` (dropout
         off; both Z-scored), ``share_below_1um_pct`` and ``diverged`` (the training loss became
-        NaN in every epoch; the numbers are then NaN).
+        NaN in every epoch, ``nets[p]`` is None; the numbers are then NaN).
     """
     rows = []
-    for p in probabilities:
-        model_cfg, train_cfg = variant_configs(data.x.shape[1], epochs=epochs, dropout=p, seed=seed)
+    y = data.exact.error_um[test_rows]
+    for p, net in nets.items():
         row = {"dropout_p": p, "final_train_mse": np.nan, "test_mse": np.nan,
-               "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
-        try:
-            net = train(
-                data, train_rows, model_cfg, train_cfg, name=f"zhang2023_sweep_p{p:g}",
-                progress=progress,
-            )  # fmt: skip
-        except TrainingDivergedError:
-            rows.append(row)
-            continue
-        y = data.exact.error_um[test_rows]
-        pred = predict_um(net, data.x[test_rows])
-        row.update(
-            final_train_mse=net.history["train"][-1],
-            test_mse=scaled_mse(net, data.x[test_rows], y),
-            share_below_1um_pct=transfer_metrics(pred, y)["share_below_1um_pct"],
-            diverged=False,
-        )
+               "share_below_1um_pct": np.nan, "diverged": net is None}  # fmt: skip
+        if net is not None:
+            row.update(
+                final_train_mse=net.history["train"][-1],
+                test_mse=scaled_mse(net, data.x[test_rows], y),
+                share_below_1um_pct=transfer_metrics(predict_um(net, data.x[test_rows]), y)[
+                    "share_below_1um_pct"
+                ],
+            )
         rows.append(row)
     return pd.DataFrame(rows)
 
 
-def dropout_conventions(sweep: pd.DataFrame, paper_t2: pd.DataFrame) -> pd.DataFrame:
-    """Table 2 in both readings of the paper's p.
+#: The batch sweep's runs: rows per update (None: the full batch) and dropout probability.
+BATCH_RUNS = tuple((b, p) for b in (1, 32, 256, None) for p in (0.5, 0.0))
 
-    Eq. 13 makes p the probability of *keeping* a unit; PyTorch's ``Dropout(p)`` drops with
-    probability p. For each of the paper's p, the run that drops 1 - p (the paper's convention)
-    and the run that drops p (PyTorch's), beside the paper's MSE; the two coincide at p = 0.5.
 
-    Parameters
-    ----------
-    sweep : pandas.DataFrame
-        :func:`dropout_sweep` over drop probabilities that include p and 1 - p of every paper
-        row (``dropout_p`` = drop probability).
-    paper_t2 : pandas.DataFrame
-        The paper table ``zhang2023_table2`` (``dropout_p``, ``mse``).
-
-    Returns
-    -------
-    pandas.DataFrame
-        ``paper_p``, ``paper_mse``; ``keep_*`` (drop 1 - p) and ``drop_*`` (drop p) columns of
-        ``final_train_mse``, ``test_mse`` and ``share_below_1um_pct``.
-    """
-    by = sweep.assign(key=sweep["dropout_p"].round(6)).set_index("key")
-    cols = ("final_train_mse", "test_mse", "share_below_1um_pct")
-    rows = []
-    for r in paper_t2.itertuples():
-        row = {"paper_p": r.dropout_p, "paper_mse": r.mse}
-        for prefix, drop in (("keep", 1.0 - r.dropout_p), ("drop", r.dropout_p)):
-            row[f"{prefix}_drop_prob"] = round(drop, 6)
-            for c in cols:
-                row[f"{prefix}_{c}"] = by.loc[round(drop, 6), c]
-        rows.append(row)
-    return pd.DataFrame(rows)
+def _batch_epochs(batch: int | None, epochs: int) -> int:
+    return {1: 1, None: 2000}.get(batch, epochs)
 
 
 def batch_sweep(
     data: SurfaceData,
     train_rows: np.ndarray,
     test_rows: np.ndarray,
+    nets: dict[tuple[int | None, float], Trained | None],
     *,
     epochs: int,
-    full: dict[float, Trained] | None = None,
-    seed: int,
-    progress: bool = True,
 ) -> pd.DataFrame:
     """The paper's settings at batches of 1, 32, 256 rows and the full batch, with dropout
-    0.5 and without.
+    0.5 and without (:data:`BATCH_RUNS`, trained by :func:`train_networks`).
 
     Batches of 32 and 256 rows run ``epochs`` epochs; batch 1 runs one epoch (12,474 updates,
-    already more than the full batch's 2000); the full batch runs the paper's 2000 epochs
-    (``full``: already trained networks by dropout probability, reused).
+    already more than the full batch's 2000); the full batch runs up to the paper's 2000 epochs
+    (early stopping, :data:`PAPER_PATIENCE`). ``epochs`` and ``updates`` count what ran.
 
     Returns
     -------
@@ -335,104 +307,26 @@ def batch_sweep(
         ``final_train_mse``, ``test_mse``, ``pred_std_um`` (spread of the predictions; the
         exact step errors' is ``exact_std_um``), ``share_below_1um_pct``, ``diverged``.
     """
-    full = full or {}
     y = data.exact.error_um[test_rows]
     n_train = len(train_rows) - round(0.1 * len(train_rows))
     rows = []
-    for batch in (1, 32, 256, None):
-        for p in (0.5, 0.0):
-            n_epochs = {1: 1, None: 2000}.get(batch, epochs)
-            model_cfg, train_cfg = paper_configs(
-                data.x.shape[1], seed=seed, dropout=p, batch_rows=batch, epochs=n_epochs
-            )
-            row = {"batch_rows": batch or 0, "dropout_p": p,
-                   "updates": n_epochs * (1 if batch is None else -(-n_train // batch)),
-                   "epochs": n_epochs, "best_epoch": np.nan, "final_train_mse": np.nan,
-                   "test_mse": np.nan, "pred_std_um": np.nan, "exact_std_um": float(y.std()),
-                   "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
-            try:
-                net = full.get(p) if batch is None else None
-                net = net or train(
-                    data, train_rows, model_cfg, train_cfg,
-                    name=f"zhang2023_batch{batch or 0}_p{p:g}", progress=progress,
-                )  # fmt: skip
-            except TrainingDivergedError:
-                rows.append(row)
-                continue
+    for batch, p in BATCH_RUNS:
+        net = nets[(batch, p)]
+        n_epochs = _batch_epochs(batch, epochs) if net is None else len(net.history["train"])
+        row = {"batch_rows": batch or 0, "dropout_p": p,
+               "updates": n_epochs * (1 if batch is None else -(-n_train // batch)),
+               "epochs": n_epochs, "best_epoch": np.nan, "final_train_mse": np.nan,
+               "test_mse": np.nan, "pred_std_um": np.nan, "exact_std_um": float(y.std()),
+               "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
+        if net is not None:
             pred = predict_um(net, data.x[test_rows])
             row.update(best_epoch=net.best_epoch, final_train_mse=net.history["train"][-1],
                        test_mse=scaled_mse(net, data.x[test_rows], y),
                        pred_std_um=float(pred.std()),
                        share_below_1um_pct=transfer_metrics(pred, y)["share_below_1um_pct"],
                        diverged=not np.isfinite(net.history["train"][-1]))  # fmt: skip
-            rows.append(row)
+        rows.append(row)
     return pd.DataFrame(rows)
-
-
-def _bins(paper: pd.DataFrame, metric: str) -> list[tuple[str, float, float]]:
-    rows = paper[paper.metric == metric]
-    out = []
-    for r in rows.itertuples():
-        lo = 0.0 if pd.isna(r.bin_lo) else float(r.bin_lo)
-        hi = np.inf if pd.isna(r.bin_hi) else float(r.bin_hi)
-        out.append((str(r.bin_label), lo, hi))
-    if np.isfinite(out[-1][2]):  # the paper's last bin is closed: count what lies beyond it
-        out.append((f"> {out[-1][2]:g}", out[-1][2], np.inf))
-    return out
-
-
-def error_histogram(
-    predicted_um: np.ndarray, exact_um: np.ndarray, paper: pd.DataFrame
-) -> pd.DataFrame:
-    """Absolute- and relative-error histograms with the paper's bins, beside the paper's.
-
-    Parameters
-    ----------
-    predicted_um, exact_um : ndarray, shape (n,)
-    paper : DataFrame
-        A table like ``zhang2023_table3`` (``metric`` ``abs_err`` in um, ``rel_err`` in %,
-        ``bin_lo``/``bin_hi``, ``count``, ``ratio_pct``). Bins are [lo, hi); where the paper's
-        last absolute bin is closed, one more row counts the errors beyond it.
-
-    Returns
-    -------
-    DataFrame
-        ``metric``, ``bin_label``, ``bin_lo``, ``bin_hi``, ``count``, ``ratio_pct``,
-        ``paper_count``, ``paper_ratio_pct``.
-    """
-    abs_err = np.abs(predicted_um - exact_um)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel_err = np.where(exact_um > 0, abs_err / exact_um * 100.0, np.inf)
-    rows = []
-    for metric, err in (("abs_err", abs_err), ("rel_err", rel_err)):
-        ref = paper[paper.metric == metric].set_index("bin_label")
-        for label, lo, hi in _bins(paper, metric):
-            count = int(np.count_nonzero((err >= lo) & (err < hi)))
-            rows.append(
-                {
-                    "metric": metric,
-                    "bin_label": label,
-                    "bin_lo": lo,
-                    "bin_hi": hi,
-                    "count": count,
-                    "ratio_pct": 100.0 * count / len(err),
-                    "paper_count": ref["count"].get(label, np.nan),
-                    "paper_ratio_pct": ref["ratio_pct"].get(label, np.nan),
-                }
-            )
-    return pd.DataFrame(rows)
-
-
-def transfer_metrics(predicted_um: np.ndarray, exact_um: np.ndarray) -> dict[str, float]:
-    """Maximum and mean absolute error (um) and the shares below 1 um and 0.5 um (%) of a test
-    set."""
-    err = np.abs(predicted_um - exact_um)
-    return {
-        "max_abs_err_um": float(err.max()),
-        "share_below_1um_pct": 100.0 * float(np.mean(err < 1.0)),
-        "share_below_0p5um_pct": 100.0 * float(np.mean(err < 0.5)),
-        "mean_abs_err_um": float(err.mean()),
-    }
 
 
 @dataclass(frozen=True, eq=False)
@@ -476,7 +370,7 @@ def transfer(
     for pct in shares_pct:
         picked, rest = split(len(data.x), pct / 100.0, seed=seed)
         if len(picked):
-            name = f"zhang2023_s{data.index}_ft{pct:g}"
+            name = f"zhang2023_s{data.index}_ft{pct:g}_seed{train_config.seed}"
             tuned = train(
                 data, picked, start.model.config, train_config, name=name, init=start,
                 progress=progress,

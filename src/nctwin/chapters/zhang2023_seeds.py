@@ -1,0 +1,255 @@
+"""The Zhang chapter's networks, trained in one pool of parallel tasks, and their ensembles.
+
+:func:`train_networks` trains every network of the chapter through
+:func:`nctwin.runner.run_tasks` (one task per network, or per chain of networks that start from
+one another; one torch thread each, so the weights do not depend on the worker or the order):
+
+* the networks the claims judge, once per seed: the paper's settings (full batch, dropout 0.5),
+  the converging variant with dropout 0.5 and without, and the fine-tuning chains of the
+  variant without dropout to surfaces 2 and 3 (each seed fine-tunes its own network);
+* the sweeps and diagnostics, once (the chapter's seed): the batch sweep, the dropout sweep
+  (Table 2), the longer fine-tuning and the network trained from scratch on surface 2.
+
+The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and
+are the same for every training seed. The claims judge the **mean of the seeds' predictions**
+(:func:`ensemble_um`, :func:`ensemble_transfer`); :func:`seed_runs` and
+:func:`nctwin.chapters.denkena2020.claims_by_seed` give every seed's own numbers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..learn.train import Trained, TrainingDivergedError
+from ..runner import run_tasks
+from .denkena2020 import claims_by_seed
+from .zhang2023 import (
+    BATCH_RUNS,
+    SurfaceData,
+    TransferRun,
+    _batch_epochs,
+    finetune_configs,
+    paper_configs,
+    predict_um,
+    split,
+    train,
+    transfer,
+    transfer_metrics,
+    variant_configs,
+)
+
+__all__ = [
+    "Networks",
+    "claims_by_seed",
+    "ensemble_transfer",
+    "ensemble_um",
+    "seed_runs",
+    "train_networks",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class Networks:
+    """Every network of the chapter (:func:`train_networks`).
+
+    Parameters
+    ----------
+    seeds : tuple of int
+    paper, dropout, variant : list of Trained
+        One per seed: the paper's settings (full batch, dropout 0.5), the variant with dropout
+        0.5 and the variant without dropout (surface 1).
+    transfer2, transfer3 : list of list of TransferRun
+        One list per seed: the seed's variant fine-tuned to surface 2 at every share, and its
+        15 % surface-2 network fine-tuned to surface 3.
+    sweep : dict
+        Dropout probability -> the variant trained ``sweep_epochs`` (None: diverged).
+    batches : dict
+        ``(batch_rows, dropout_p)`` of :data:`~nctwin.chapters.zhang2023.BATCH_RUNS` -> the
+        paper's settings at that batch (None: diverged); the full batch at dropout 0.5 is
+        ``paper[0]``.
+    longer : Trained
+        The first seed's variant fine-tuned with 15 % of surface 2 for ``longer_epochs``.
+    scratch : Trained
+        The variant trained from scratch on the same 15 % of surface 2.
+    """
+
+    seeds: tuple[int, ...]
+    paper: list[Trained]
+    dropout: list[Trained]
+    variant: list[Trained]
+    transfer2: list[list[TransferRun]]
+    transfer3: list[list[TransferRun]]
+    sweep: dict[float, Trained | None]
+    batches: dict[tuple[int | None, float], Trained | None]
+    longer: Trained
+    scratch: Trained
+
+
+def _train_or_none(data, rows, model_config, train_config, name) -> Trained | None:
+    try:
+        return train(data, rows, model_config, train_config, name=name, progress=False)
+    except TrainingDivergedError:
+        return None
+
+
+def _chain(d1, train_rows, d2, d3, shares, epochs, seed, train_seed, longer_epochs):
+    """The variant without dropout (seed ``train_seed``) and its fine-tuning chains; with
+    ``longer_epochs`` > 0 also the longer fine-tuning to 15 % of surface 2."""
+    n = d1.x.shape[1]
+    model_cfg, train_cfg = variant_configs(n, epochs=epochs, dropout=0.0, seed=train_seed)
+    name = f"zhang2023_variant_p0_seed{train_seed}"
+    net1 = train(d1, train_rows, model_cfg, train_cfg, name=name, progress=False)
+    _, ft = finetune_configs(n, epochs=2 * epochs, seed=train_seed)
+    runs2 = transfer(net1, d2, shares, ft, seed=seed, progress=False)
+    runs3 = transfer(runs2[-1].trained, d3, shares, ft, seed=seed, progress=False)
+    longer = None
+    if longer_epochs:
+        _, ft_long = finetune_configs(n, epochs=longer_epochs, seed=train_seed)
+        longer = transfer(net1, d2, (15.0,), ft_long, seed=seed, progress=False)[0].trained
+    return net1, runs2, runs3, longer
+
+
+def _call(fn: Callable, args: tuple):
+    return fn(*args)
+
+
+def train_networks(
+    data: dict[int, SurfaceData],
+    train_rows: np.ndarray,
+    seeds: Sequence[int],
+    *,
+    epochs: int,
+    sweep_epochs: int,
+    probabilities: Sequence[float],
+    shares: tuple[float, ...],
+    longer_epochs: int,
+    seed: int,
+    n_jobs: int = 2,
+) -> Networks:
+    """Train every network of the chapter (see the module docstring), ``n_jobs`` at a time.
+
+    Parameters
+    ----------
+    data : dict
+        Surface index (1, 2, 3) -> :class:`SurfaceData`.
+    train_rows : ndarray of int
+        Surface 1's training rows (the 70 %).
+    seeds : sequence of int
+        Training seeds of the networks the claims judge; ``seeds[0]`` also trains the sweeps
+        and diagnostics.
+    epochs, sweep_epochs, longer_epochs : int
+        The variant's epochs (fine-tuning: twice as many), the sweeps' and the longer
+        fine-tuning's.
+    probabilities : sequence of float
+        The dropout sweep's drop probabilities.
+    shares : tuple of float
+        Fine-tuning shares (%), increasing, the last 15.
+    seed : int
+        Seed of the data splits.
+    n_jobs : int
+        Parallel trainings.
+    """
+    d1, d2 = data[1], data[2]
+    n = d1.x.shape[1]
+    s0 = seeds[0]
+
+    def task(fn, *args):
+        return (fn, args)
+
+    tasks = {}  # the slowest first: the runner hands tasks out in order
+    cfgs = paper_configs(n, seed=s0, dropout=0.0)
+    tasks["batch", None, 0.0] = task(_train_or_none, d1, train_rows, *cfgs, "zhang2023_batch0_p0")
+    for s in seeds:
+        tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, epochs, seed, s,
+                                 longer_epochs if s == s0 else 0)  # fmt: skip
+    for s in seeds:
+        cfgs = paper_configs(n, seed=s)
+        tasks["paper", s] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_paper_seed{s}")
+    for s in seeds:
+        cfgs = variant_configs(n, epochs=epochs, dropout=0.5, seed=s)
+        tasks["dropout", s] = task(_train_or_none, d1, train_rows, *cfgs,
+                                   f"zhang2023_variant_p0.5_seed{s}")  # fmt: skip
+    for batch, p in BATCH_RUNS:
+        if batch is not None:
+            cfgs = paper_configs(n, seed=s0, dropout=p, batch_rows=batch,
+                                 epochs=_batch_epochs(batch, sweep_epochs))  # fmt: skip
+            tasks["batch", batch, p] = task(_train_or_none, d1, train_rows, *cfgs,
+                                            f"zhang2023_batch{batch}_p{p:g}")  # fmt: skip
+    for p in probabilities:
+        cfgs = variant_configs(n, epochs=sweep_epochs, dropout=p, seed=s0)
+        tasks["sweep", p] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_sweep_p{p:g}")
+    picked2, _ = split(len(d2.x), 0.15, seed=seed)
+    cfgs = variant_configs(n, epochs=2 * epochs, seed=s0)
+    tasks["scratch"] = task(_train_or_none, d2, picked2, *cfgs, "zhang2023_s2_scratch15")
+    out = dict(zip(tasks, run_tasks(_call, tasks.values(), n_jobs=n_jobs), strict=True))
+    chains = [out["chain", s] for s in seeds]
+    return Networks(
+        seeds=tuple(seeds),
+        paper=[out["paper", s] for s in seeds],
+        dropout=[out["dropout", s] for s in seeds],
+        variant=[c[0] for c in chains],
+        transfer2=[c[1] for c in chains],
+        transfer3=[c[2] for c in chains],
+        sweep={p: out["sweep", p] for p in probabilities},
+        batches={
+            (b, p): out["paper", s0] if (b, p) == (None, 0.5) else out["batch", b, p]
+            for b, p in BATCH_RUNS
+        },
+        longer=chains[0][3],
+        scratch=out["scratch"],
+    )
+
+
+def ensemble_um(nets: Sequence[Trained], x: np.ndarray) -> np.ndarray:
+    """The mean of the networks' predicted step errors (um) of samples ``x``."""
+    return np.mean([predict_um(net, x) for net in nets], axis=0)
+
+
+def ensemble_transfer(chains: Sequence[Sequence[TransferRun]]) -> list[TransferRun]:
+    """One :class:`TransferRun` per share whose prediction is the mean of the seeds'
+    (``trained``: the first seed's network)."""
+    return [
+        TransferRun(r[0].surface, r[0].finetune_pct, r[0].trained, r[0].test_rows,
+                    np.mean([m.predicted_um for m in r], axis=0))
+        for r in zip(*chains, strict=True)
+    ]  # fmt: skip
+
+
+def seed_runs(
+    nets: dict[str, Sequence[Trained]], x: np.ndarray, y_um: np.ndarray, y_std_um: float
+) -> pd.DataFrame:
+    """Every seed's network and the ensemble (``seed`` = -1) of each label on test samples.
+
+    Parameters
+    ----------
+    nets : dict
+        Label -> the networks of the seeds.
+    x, y_um : ndarray
+        Test samples and their exact step errors.
+    y_std_um : float
+        The Z-score's scale of ``test_mse`` (the standard deviation of the training rows'
+        step errors, eq. 7), the same for every seed and the ensemble.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``network``, ``seed``, ``epochs``, ``best_epoch``, ``converged`` (the best epoch lies
+        more than the patience below the cap; NaN for the ensemble), ``test_mse`` and
+        :func:`transfer_metrics`.
+    """
+    rows = []
+    for label, members in nets.items():
+        preds = [predict_um(m, x) for m in members]
+        for m, pred in [*zip(members, preds, strict=True), (None, np.mean(preds, axis=0))]:
+            cfg = m.train_config if m is not None else None
+            rows.append({"network": label, "seed": cfg.seed if cfg else -1,
+                         "epochs": len(m.history["train"]) if m else np.nan,
+                         "best_epoch": m.best_epoch if m else np.nan,
+                         "converged": m.best_epoch < cfg.max_epochs - cfg.patience if m else np.nan,
+                         "test_mse": float(np.mean(((pred - y_um) / y_std_um) ** 2)),
+                         **transfer_metrics(pred, y_um)})  # fmt: skip
+    return pd.DataFrame(rows)
