@@ -1,6 +1,6 @@
 # nctwin — reproducibility package for five NC-machining papers.
 #
-#   make reproduce   set up .venv, execute every notebook, build the book (HTML); one line per
+#   make reproduce   set up .venv and LinuxCNC, execute every notebook, build the book (HTML); one line per
 #                    step, "[k/N] ... (last run ...)", with the step's duration from the last run
 #   make test        what CI runs (.ci/run): LinuxCNC, lint, unit tests, nbval (and that it leaves
 #                    results/ as it found it), book, browser check
@@ -56,7 +56,7 @@ endif
         clean distclean linuxcnc record FORCE
 
 help:
-	@echo "make reproduce   venv -> mathjax -> notebooks (papermill) -> book; prints the HTML path"
+	@echo "make reproduce   venv -> mathjax -> linuxcnc -> notebooks (papermill) -> book; prints the HTML path"
 	@echo "make test        venv, linuxcnc, ruff, pytest (tests/), nbval on book/notebooks, book build, browser check"
 	@echo "make venv        create/refresh .venv from requirements.txt (skipped when up to date)"
 	@echo "make mathjax     local MathJax $(MATHJAX_VERSION) (npm) into $(MATHJAX_DIR)"
@@ -227,13 +227,15 @@ book: $(BOOK_SETUP) | $(EXECUTED)
 	echo "book: built in $$(( $$(date +%s) - t0 )) s"; \
 	echo "book: $(CURDIR)/$(HTML_DIR)/index.html"
 
-# reproduce: venv, MathJax, every notebook, the book; one "[k/N]" line per step.
+# reproduce: venv, MathJax, LinuxCNC (its interpreter reads the chapters' programs in the whole
+# language), every notebook, the book; one "[k/N]" line per step.
 reproduce:
-	@$(STEP_SH) nbs=($(EXECUTED)); n=$$(( 3 + $${#nbs[@]} )); k=0; t_all=$$(date +%s); \
+	@$(STEP_SH) nbs=($(EXECUTED)); n=$$(( 4 + $${#nbs[@]} )); k=0; t_all=$$(date +%s); \
 	run() { local name=$$1; shift; k=$$((k + 1)); echo "[$$k/$$n] $$name ($$(last_run $$name))"; \
 	  local t0=$$(date +%s); $(MAKE) --no-print-directory "$$@"; record_s $$name $$(( $$(date +%s) - t0 )); }; \
 	run venv venv; \
 	run mathjax mathjax; \
+	run linuxcnc linuxcnc; \
 	for nb in "$${nbs[@]}"; do k=$$((k + 1)); \
 	  $(MAKE) --no-print-directory NB_FORCE=FORCE NB_VENV= STEP="[$$k/$$n] " $$nb; \
 	done; \

@@ -34,3 +34,16 @@ def linuxcnc_live() -> None:
         pytest.fail(f"NCTWIN_REQUIRE_LINUXCNC=1 but LinuxCNC cannot run: {why}")
     if why:
         pytest.skip(f"LinuxCNC: {why}")
+
+
+@pytest.fixture
+def linuxcnc_interpreter() -> None:
+    """Skip a test of LinuxCNC's interpreter (the ``linuxcnc`` reader) where it is missing, or
+    fail it where ``NCTWIN_REQUIRE_LINUXCNC=1`` (``make test``)."""
+    from nctwin.gcode import interpreter_available
+
+    if interpreter_available():
+        return
+    if os.environ.get("NCTWIN_REQUIRE_LINUXCNC") == "1":
+        pytest.fail("NCTWIN_REQUIRE_LINUXCNC=1 but LinuxCNC's interpreter is missing")
+    pytest.skip("LinuxCNC's interpreter is missing (make linuxcnc)")

@@ -382,3 +382,62 @@ def test_the_command_line_does_not_import_torch_unless_a_network_runs():
     code = "import sys, nctwin.cli; print('torch' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+SUBROUTINE = """G21 G90 F600
+o100 sub
+  G1 X[#1] Y[#2]
+o100 endsub
+o100 call [10] [0]
+o100 call [10] [20]
+M2
+"""
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+def test_reader_auto_hands_what_only_linuxcnc_reads_to_its_interpreter(tmp_path, capsys):
+    prog = tmp_path / "sub.ngc"
+    prog.write_text(SUBROUTINE)
+    assert main(["estimate", str(prog), "--json", "--method", "cam"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    # 10 mm then 20 mm at 10 mm/s, the blocks on the subroutine's line
+    assert data["reader"] == "linuxcnc" and data["blocks"] == 2
+    assert data["cycle_time_s"] == pytest.approx(3.0)
+    assert main(["estimate", str(prog), "--reader", "linuxcnc"]) == 0
+    assert "reader       LinuxCNC's interpreter" in capsys.readouterr().out
+
+
+def test_reader_native_refuses_what_only_linuxcnc_reads(tmp_path, capsys):
+    prog = tmp_path / "sub.ngc"
+    prog.write_text(SUBROUTINE)
+    assert main(["estimate", str(prog), "--reader", "native"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith(f"{prog}:2: O-word")
+    assert err[0].endswith("needs LinuxCNC's interpreter: run make linuxcnc")
+    assert "Traceback" not in "".join(err)
+
+
+def test_reader_of_a_plain_program_is_native(program, capsys):
+    assert main(["estimate", str(program), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["reader"] == "native"
+    assert main(["simulate", str(program), "--json", "--reader", "native"]) == 0
+    assert json.loads(capsys.readouterr().out)["reader"] == "native"
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("G1 X1 A5 F600\n", ":1: axis A is not supported"),
+        ("G21 F600\n#1 = [1 / 0]\nG1 X#1\n", ":2: "),
+        ("G21 F600\no100 while [1]\nG1 X1\nG1 X0\no100 endwhile\n", ""),
+        ("G21 F600\no<missing_sub> call\n", ":2: "),
+    ],
+)
+def test_programs_linuxcnc_refuses_give_one_line_per_error(tmp_path, capsys, text, needle):
+    prog = tmp_path / "bad.ngc"
+    prog.write_text(text)
+    assert main(["estimate", str(prog), "--method", "cam"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"{prog}:") and needle in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1

@@ -53,7 +53,7 @@ def test_public_program_absent_or_changed(tmp_path):
 
 
 def test_public_program_nctwin_rejects_needs_no_linuxcnc(tmp_path):
-    (tmp_path / "bad.ngc").write_text("G1 X#1\n")
+    (tmp_path / "bad.ngc").write_text("G1 X1 A5\n")  # no reader reads a rotary axis
     recorded, rejected = record.record_public(tmp_path, tmp_path / "out")
     assert recorded == [] and list(rejected) == ["bad.ngc"]
     assert "bad.ngc:1:" in rejected["bad.ngc"]

@@ -25,7 +25,7 @@ import numpy as np
 from . import __version__
 from .estimate import METHODS, default_method, estimate
 from .estimate.kernel import fir_settings
-from .gcode import GCodeError, parse
+from .gcode import READERS, GCodeError, read
 from .kernel import fir
 from .machine import DEFAULT_MACHINE, MachineProfile, available_machines, load_machine
 from .motion import Motion
@@ -41,7 +41,12 @@ on the FIR kernel with a plot of the feed.
 A program is a file, or - for standard input. Bad input ends with exit code 2 and
 one line on standard error: file:line: reason for a line of the program that
 cannot be read, file: reason for a file that is not a program, nctwin: reason
-for the rest."""
+for the rest.
+
+Programs are read by nctwin's own fast reader; what only LinuxCNC's interpreter
+reads (O-word subroutines and loops, #parameters and expressions, cutter
+compensation) goes to that interpreter where it is installed (make linuxcnc):
+--reader chooses. The output says which reader read the program."""
 
 EXAMPLES = """\
 examples:
@@ -50,6 +55,7 @@ examples:
   nctwin estimate part.nc --machine fanuc_0i_testbed --method block_overlap --json
   nctwin estimate part.nc --machine linuxcnc_sim   LinuxCNC: its chapter's best method
   cat part.nc | nctwin estimate -                  the program from standard input
+  nctwin estimate part.ngc --reader native         refuse what only LinuxCNC reads
   nctwin simulate part.nc --plot feed.png --csv motion.csv
   nctwin machines"""
 
@@ -70,6 +76,7 @@ examples:
   nctwin estimate part.nc --method kernel --json
   nctwin estimate part.nc --machine linuxcnc_sim --method bilstm
   nctwin estimate part.nc --machine own_machine.toml
+  nctwin estimate part.ngc --reader linuxcnc       subroutines, #parameters, G41/G42
   cat part.nc | nctwin estimate -"""
 
 SIMULATE_EXAMPLES = """\
@@ -210,7 +217,15 @@ def _program_args(p: argparse.ArgumentParser) -> None:
         "--dwell-p-unit",
         default="s",
         choices=("s", "ms"),
-        help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc)",
+        help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc; native reader only)",
+    )
+    p.add_argument(
+        "--reader",
+        default="auto",
+        choices=READERS,
+        help="G-code reader: native (fast, the RS274/NGC a CAM post writes), linuxcnc "
+        "(LinuxCNC's own interpreter: subroutines, parameters, cutter compensation; needs make "
+        "linuxcnc) or auto (native, LinuxCNC's interpreter for what only it reads; default)",
     )
 
 
@@ -259,8 +274,11 @@ def program_units(text: str, default: str = "mm") -> str:
     return "inch" if match.group(1) == "0" else "mm"
 
 
-def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Toolpath, str]:
-    """The machine, the parsed program and its text.
+def _load(
+    args: argparse.Namespace, stage: _Stages
+) -> tuple[MachineProfile, Toolpath, str, str]:
+    """The machine, the parsed program, its text and the reader that read it (``native`` or
+    ``linuxcnc``; subroutine files are looked up beside the program).
 
     Raises
     ------
@@ -272,10 +290,14 @@ def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Too
     stage("read")
     text, source = _read_program(args.program)
     stage("parse")
-    tp = parse(text, source=source, units=args.input_units, dwell_p_unit=args.dwell_p_unit)
+    kwargs = {"source": source, "units": args.input_units, "dwell_p_unit": args.dwell_p_unit}
+    if args.program != "-" and args.reader != "native":
+        kwargs["folder"] = Path(args.program).resolve().parent
+    result = read(text, reader=args.reader, **kwargs)
+    tp = result.toolpath
     if not ((tp.lengths_mm > 0).any() or (tp.dwell_s > 0).any()):
         raise InputError(f"{source}: no motion")
-    return machine, tp, text
+    return machine, tp, text, result.reader
 
 
 def _report(summary: dict, rows: list[tuple[str, str]], extra: list[str], as_json: bool) -> int:
@@ -290,10 +312,15 @@ def _report(summary: dict, rows: list[tuple[str, str]], extra: list[str], as_jso
     return 0
 
 
+#: How the output names a reader.
+_READER_NAMES = {"native": "native", "linuxcnc": "LinuxCNC's interpreter"}
+
+
 def _common_rows(summary: dict, machine_note: str = "") -> list[tuple[str, str]]:
     t = summary["cycle_time_s"]
     return [
         ("program", summary["program"]),
+        ("reader", _READER_NAMES[summary["reader"]]),
         ("machine", summary["machine"] + machine_note),
         ("cycle time", f"{t:.3f} s  ({_format_duration(t)})"),
         ("path length", f"{summary['length_mm']:.3f} mm"),
@@ -309,18 +336,18 @@ def _estimate(args: argparse.Namespace, enabled: bool) -> int:
     method = args.method
     stage = _Stages(["machine", "read", "parse", "estimate"], enabled)
     try:
-        machine, tp, _ = _load(args, stage)
+        machine, tp, _, reader = _load(args, stage)
         method = method or default_method(machine)
         learned = method in ("bilstm", "axis_nn")
         stage(f"estimate: {method}" + (" (trains on first use)" if learned else ""))
         result = estimate(tp, machine, method)
     finally:
         stage.close()
-    summary = {"program": _program_name(args), **result.summary()}
+    summary = {"program": _program_name(args), "reader": reader, **result.summary()}
     rows = _common_rows(summary)
-    rows.insert(2, ("method", result.method))
+    rows.insert(3, ("method", result.method))
     if result.floor_time_s is not None:
-        rows.insert(4, ("floor", f"{result.floor_time_s:.3f} s  (every move at its feed)"))
+        rows.insert(5, ("floor", f"{result.floor_time_s:.3f} s  (every move at its feed)"))
     table = [f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}"] + [
         f"  {kind:<8} {r['blocks']:>8d} {r['length_mm']:>12.3f} {r['time_s']:>10.3f}"
         for kind, r in summary["by_kind"].items()
@@ -380,7 +407,7 @@ def _simulate(args: argparse.Namespace, enabled: bool) -> int:
     stages += ["plot"] * bool(args.plot) + ["csv"] * bool(args.csv)
     stage = _Stages(stages, enabled)
     try:
-        machine, tp, text = _load(args, stage)
+        machine, tp, text, reader = _load(args, stage)
         stage("simulate (FIR kernel)")
         motion = fir.run(tp, machine, fir_settings(machine))
         feed_unit = args.units or (
@@ -388,6 +415,7 @@ def _simulate(args: argparse.Namespace, enabled: bool) -> int:
         )
         summary = {
             "program": _program_name(args),
+            "reader": reader,
             "machine": machine.name,
             "kernel": "fir",
             "cycle_time_s": motion.cycle_time_s,

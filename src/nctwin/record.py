@@ -4,7 +4,9 @@ LinuxCNC (:mod:`nctwin.kernel.linuxcnc`) is the measured machine. This module ru
 1's training programs (:func:`nctwin.programs.training.training_specs`, F 65-100 mm/s,
 G64 P 0.05-0.5 mm), a broader set (:data:`BROAD`), CAM-style programs
 (:func:`nctwin.programs.camstyle.cam_program`), the test programs (toolpaths I and II, the
-pocket; F 75 and 92 mm/s, G64 P 0.3 and 0.4 mm) and the public programs of
+pocket; F 75 and 92 mm/s, G64 P 0.3 and 0.4 mm), programs in the whole language
+(:data:`nctwin.programs.language.LANGUAGE_PROGRAMS`: cycles, cutter compensation, subroutines,
+parameters) and the public programs of
 :func:`nctwin.paths.public_programs_dir`, and saves them in the format of
 :mod:`nctwin.recordings`, which loads them without LinuxCNC.
 """
@@ -24,6 +26,7 @@ from .kernel import linuxcnc
 from .machine import MachineProfile, load_machine
 from .paths import public_programs_dir
 from .programs.camstyle import cam_program
+from .programs.language import LANGUAGE_PROGRAMS
 from .programs.pocket import pocket_program
 from .programs.training import broad_program, contour_program, training_specs
 from .recordings import (
@@ -40,6 +43,7 @@ from .targets import block_targets
 
 __all__ = [
     "PUBLIC_SUFFIXES",
+    "RECORDED_SETS",
     "record_program",
     "record_public",
     "record_set",
@@ -104,18 +108,21 @@ TEST_FEEDS_MM_S = (75.0, 92.0)
 TEST_TOLS_MM = (0.3, 0.4)
 
 
-def recording_programs(
-    sets: tuple[str, ...] = ("train", "broad", "cam", "test"),
-) -> dict[str, str]:
+#: The sets of :func:`recording_programs`.
+RECORDED_SETS = ("train", "broad", "cam", "test", "language")
+
+
+def recording_programs(sets: tuple[str, ...] = RECORDED_SETS) -> dict[str, str]:
     """The shipped set: name -> G-code text (see the module docstring).
 
     ``train_*``: paper 1's training programs (:data:`N_PROGRAMS` of :data:`N_LINES` lines);
     ``broad_*``: the broad set (:data:`BROAD`); ``cam_*``: the CAM-style set (:data:`N_CAM`
-    programs); ``test_*``: toolpaths I and II and the pocket. ``sets`` picks some of them.
+    programs); ``test_*``: toolpaths I and II and the pocket; ``lang_*``: the programs of
+    :data:`~nctwin.programs.language.LANGUAGE_PROGRAMS`. ``sets`` picks some of them.
     """
-    unknown = set(sets) - {"train", "broad", "cam", "test"}
+    unknown = set(sets) - set(RECORDED_SETS)
     if unknown:
-        raise ValueError(f"sets = {sets!r} is not allowed: allowed train, broad, cam, test")
+        raise ValueError(f"sets = {sets!r} is not allowed: allowed {', '.join(RECORDED_SETS)}")
     out: dict[str, str] = {}
     specs = training_specs(
         RECORD_SEED,
@@ -141,6 +148,8 @@ def recording_programs(
                     else contour_program(name, feed_mm_s=f, tol_mm=e)
                 )
                 out[f"test_{name}_F{f:g}_P{e:g}"] = _q0(text, e)
+    if "language" in sets:
+        out |= {f"lang_{name}": program() for name, program in LANGUAGE_PROGRAMS.items()}
     return out
 
 
@@ -201,7 +210,7 @@ def record_set(
     *,
     n_jobs: int = 2,
     speed: float = 5,
-    sets: tuple[str, ...] = ("train", "broad", "cam", "test"),
+    sets: tuple[str, ...] = RECORDED_SETS,
 ) -> list[RecordedProgram]:
     """Record every program of :func:`recording_programs` and save them into ``folder``.
 
