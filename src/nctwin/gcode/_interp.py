@@ -37,12 +37,13 @@ units, planes, offsets. Its canonical moves are turned into the same
   which it calls at the first canonical call of a line, with the state *before* that line
   (``write_settings`` runs after a block). To see the state after every line, each line of the
   program is given a comment ``(.)`` (an empty one makes no call), whose ``COMMENT`` call makes
-  every executed line report (and LinuxCNC's error lines exact); the state a line's moves run in is the one the next line reports. ``settings[3:5]``
-  of the reported state are G64's P and Q (``write_settings``); the module does not name them,
-  so they are read from the object's memory, checked against ``settings[1]`` (the feed), which
-  it does name. Before the program the interpreter runs ``G64 P987654321 Q987654321``, a
-  sentinel: a block in that state is in :attr:`~nctwin.toolpath.PathMode.DEFAULT` mode, as
-  the native reader marks blocks before any G61/G64.
+  every executed line report (and LinuxCNC's error lines exact); the state a line's moves run
+  in is the one the next line reports. ``settings[3:5]`` of the reported state are G64's P and
+  Q (``write_settings``); the module does not name them, so they are read from the object's
+  memory, checked against the fields it does name (feed, line, modes). Before the program the
+  interpreter runs ``G64 P987654321 Q987654321``, a sentinel: a block in that state is in
+  :attr:`~nctwin.toolpath.PathMode.DEFAULT` mode, as the native reader marks blocks before any
+  G61/G64.
 * Canned cycles: LinuxCNC runs their moves in exact-path mode (but a first rapid up to R from
   below it); the module does not report that switch, so those blocks are marked here, as the
   native reader marks them.
