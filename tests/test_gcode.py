@@ -139,7 +139,7 @@ def test_program_g64_p_in_inch_is_converted():
 )
 def test_errors_name_line_and_reason(text, line, reason):
     with pytest.raises(GCodeError) as info:
-        parse(text, source="p.nc")
+        parse(text, source="p.nc", reader="native")
     err = info.value
     assert err.line == line
     assert reason in err.reason

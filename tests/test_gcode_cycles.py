@@ -187,7 +187,7 @@ def test_cycles_in_the_zx_and_yz_planes_drill_along_y_and_x():
 def test_g84_outside_g17_is_left_to_linuxcnc():
     # LinuxCNC 2.9's convert_cycle_g74_g84 maps the plane's axes twice there
     with pytest.raises(GCodeError, match=r"G84 in the G18 plane .* needs LinuxCNC's interpreter"):
-        parse("M3\nG18 G0 Y10\nG84 X1 R2 Y-1 F60")
+        parse("M3\nG18 G0 Y10\nG84 X1 R2 Y-1 F60", reader="native")
 
 
 def test_words_carry_over_between_lines_of_the_same_cycle_only():

@@ -13,7 +13,7 @@ NEEDS = "needs LinuxCNC's interpreter: run make linuxcnc"
 
 def refusal(text: str) -> GCodeError:
     with pytest.raises(GCodeError) as info:
-        parse(text, source="part.nc")
+        parse(text, source="part.nc", reader="native")
     return info.value
 
 

@@ -273,17 +273,20 @@ def evaluation_programs(
     """
     programs = {}
     for name, rec in recordings.items():
-        if name.startswith(("test_", "lang_")):
-            group = "test paths" if name.startswith("test_") else "language"
-            programs[name] = (group, parse(rec.program), recorded_move_data(rec, machine))
+        if name.startswith("test_"):
+            programs[name] = ("test paths", parse(rec.program), recorded_move_data(rec, machine))
+            continue
+        if name.startswith("lang_"):
+            group, text = "language", rec.program
         elif rec.source != "nctwin":
-            text = public_program_text(rec)
-            if text is not None:
-                tp = parse(text)
-                data = dataclasses.replace(
-                    move_data(name, tp, machine), measured_s=rec.cycle_time_s
-                )
-                programs[name.removeprefix("public_")] = ("public", tp, data)
+            group, text, name = "public", public_program_text(rec), name.removeprefix("public_")
+        else:
+            continue
+        if text is not None:  # scored on the cycle time alone (arcs give no per-move targets)
+            tp = parse(text)
+            data = move_data(rec.name, tp, machine)
+            data = dataclasses.replace(data, measured_s=rec.cycle_time_s)
+            programs[name] = (group, tp, data)
     public_absent = [n for n, r in recordings.items() if r.source != "nctwin"
                      and n.removeprefix("public_") not in programs]  # fmt: skip
     return programs, public_absent

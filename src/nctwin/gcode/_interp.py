@@ -110,6 +110,9 @@ _CHILD = Path(__file__).with_name("_linuxcnc_child.py")
 _CHILD_MARGIN_S = 2.5
 _MARK = "(.)"
 _MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
+#: The longest line LinuxCNC 2.9's interpreter reads (characters before the newline, measured:
+#: 253 gives "Command too long").
+LINUXCNC_MAX_LINE = 252
 _N_MOVE, _N_MODAL = 7, 13
 #: LinuxCNC's canon planes (1 XY, 2 YZ, 3 XZ) as :class:`Plane`.
 _PLANE_OF_CANON = np.array([0, Plane.XY, Plane.YZ, Plane.ZX], dtype=np.int8)
@@ -241,6 +244,13 @@ def read_linuxcnc(
     if "\0" in text:
         line = text.count("\n", 0, text.index("\0")) + 1
         raise GCodeError(line, "", "binary data (NUL bytes), not a G-code program", source)
+    long = [i for i, ln in enumerate(text.split("\n")) if len(ln) > LINUXCNC_MAX_LINE]
+    if long:  # LinuxCNC reports the line after it, or none if it is the last
+        n = len(text.split("\n")[long[0]])
+        raise GCodeError(
+            long[0] + 1, "", f"a line of {n} characters: LinuxCNC reads at most "
+            f"{LINUXCNC_MAX_LINE} (Command too long)", source,
+        )  # fmt: skip
     if not interpreter_available():
         raise GCodeError(0, "", _NOT_INSTALLED, source)
     with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:
@@ -470,6 +480,13 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     after = _after_states(events)
     lines = events[ev, 0].astype(np.int64)
     _refuse_modes(kind, ev, after, lines, source)
+    no_feed = ((kind == 1) | (kind == 2)) & ~(mod[:, 0] > 0)
+    if no_feed.any():  # the preview module runs it; LinuxCNC's task refuses it
+        k = int(np.argmax(no_feed))
+        raise GCodeError(
+            int(lines[k]), "", "feed move with no feed rate set (F): LinuxCNC refuses it (Cannot"
+            " do G1 with zero feed rate)", source,
+        )  # fmt: skip
     n = len(moves)
     arc = kind == 2
     plane = _PLANE_OF_CANON[mod[:, 1].astype(np.int64)]

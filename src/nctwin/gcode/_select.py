@@ -48,9 +48,9 @@ def _check_reader(reader: str) -> None:
         raise ValueError(f"reader = {reader!r} is not allowed: allowed {allowed}")
 
 
-def _only_interpreter_needed(err: GCodeError) -> bool:
-    """Whether the native reader refused only constructs LinuxCNC's interpreter reads."""
-    return all(_NEEDS_LINUXCNC in e.reason for e in err.errors)
+def _needs_interpreter(err: GCodeError) -> bool:
+    """Whether the native reader refused a construct only LinuxCNC's interpreter reads."""
+    return any(_NEEDS_LINUXCNC in e.reason for e in err.errors)
 
 
 def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
@@ -63,9 +63,12 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
     reader : {"auto", "native", "linuxcnc"}
         ``"native"``: :func:`nctwin.gcode.parse`'s own reader (numpy, the RS274/NGC subset of a
         CAM post). ``"linuxcnc"``: LinuxCNC's rs274ngc interpreter, the whole language
-        (:func:`read_linuxcnc`). ``"auto"``: the native reader, and where it refuses only
-        constructs that need the interpreter (O-words, parameters, cutter compensation, ...),
-        the interpreter if it is installed; otherwise the native reader's error stands.
+        (:func:`read_linuxcnc`). ``"auto"``: the native reader, and where it refuses a program,
+        the interpreter if it is installed (it reads what the native reader leaves to it:
+        O-words, parameters, cutter compensation, and words such as ``M66 P`` the native reader
+        does not know). Where both refuse, the error is the native reader's, which lists every
+        error of the program, unless it names a construct only the interpreter reads: then the
+        interpreter's, which read it.
     **kwargs
         ``source``, ``units``, ``block_delete`` for both readers; ``dwell_p_unit``,
         ``start_mm``, ``arc_tol_mm``, ``arc_tol_rel`` for the native reader only (with
@@ -105,11 +108,15 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
     try:
         return ReadResult(parse_native(text, **native), "native")
     except GCodeError as err:
-        if reader == "native" or changed or not _only_interpreter_needed(err):
+        if reader == "native" or changed or not interpreter_available():
             raise
-        if not interpreter_available():
+        native_error = err
+    try:
+        return ReadResult(read_linuxcnc(text, **interp), "linuxcnc")
+    except GCodeError:
+        if _needs_interpreter(native_error):
             raise
-    return ReadResult(read_linuxcnc(text, **interp), "linuxcnc")
+        raise native_error from None
 
 
 def _differs(value, name: str) -> bool:
