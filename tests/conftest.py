@@ -36,7 +36,7 @@ def linuxcnc_live() -> None:
         pytest.skip(f"LinuxCNC: {why}")
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def linuxcnc_interpreter() -> None:
     """Skip a test of LinuxCNC's interpreter (the ``linuxcnc`` reader) where it is missing, or
     fail it where ``NCTWIN_REQUIRE_LINUXCNC=1`` (``make test``)."""

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import inspect
 import json
-import os
 import time
 from pathlib import Path
 
@@ -63,15 +62,6 @@ PUBLIC = sorted(
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "programs"
 #: Agreement: coordinates (mm), feed (relative).
 ATOL_MM, FEED_RTOL = 1e-6, 1e-9
-
-
-@pytest.fixture(scope="module")
-def linuxcnc() -> None:
-    """Skip where LinuxCNC's interpreter is missing; fail there under NCTWIN_REQUIRE_LINUXCNC=1."""
-    if not interpreter_available():
-        if os.environ.get("NCTWIN_REQUIRE_LINUXCNC") == "1":
-            pytest.fail("NCTWIN_REQUIRE_LINUXCNC=1 but LinuxCNC's gcode module is missing")
-        pytest.skip("LinuxCNC's gcode module is missing: run `make linuxcnc`")
 
 
 def _moving(tp: Toolpath) -> Toolpath:
@@ -113,7 +103,7 @@ def _both(text: str) -> tuple[Toolpath, Toolpath]:
 # The two readers agree
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("path", PUBLIC, ids=lambda p: p.name)
-def test_public_programs_agree(linuxcnc, path):
+def test_public_programs_agree(linuxcnc_interpreter, path):
     result = read_file(path)  # auto: the native reader, LinuxCNC's where only it reads it
     try:
         native = parse_file(path, reader="native")
@@ -125,7 +115,7 @@ def test_public_programs_agree(linuxcnc, path):
     assert_agree(native, parse_file(path, reader="linuxcnc"))
 
 
-def test_shared_programs_agree(linuxcnc):
+def test_shared_programs_agree(linuxcnc_interpreter):
     if not SHARED.is_dir():
         pytest.skip("../shared/programs is not beside this clone")
     compared = 0
@@ -151,11 +141,11 @@ def test_shared_programs_agree(linuxcnc):
     ],
     ids=["cam0", "cam1", "cam2", "camblend", "finishing3d", "drill_cycles"],
 )
-def test_generated_programs_agree(linuxcnc, text):
+def test_generated_programs_agree(linuxcnc_interpreter, text):
     assert_agree(*_both(text))
 
 
-def test_fanuc_dwell_is_native_only(linuxcnc):
+def test_fanuc_dwell_is_native_only(linuxcnc_interpreter):
     """ISO 10791-7's test piece dwells with Fanuc's ``G04 X0.5``: the native reader reads it
     (its docstring says so), LinuxCNC refuses it; with ``G4 P0.5`` the two agree."""
     text = iso10791.test_piece_program()
@@ -165,7 +155,7 @@ def test_fanuc_dwell_is_native_only(linuxcnc):
     assert_agree(*_both(text.replace("G04 X0.5", "G4 P0.5")))
 
 
-def test_language_programs_are_read_by_linuxcnc(linuxcnc):
+def test_language_programs_are_read_by_linuxcnc(linuxcnc_interpreter):
     """nctwin's programs in the whole language: auto reads them through LinuxCNC."""
     for name, make in LANGUAGE_PROGRAMS.items():
         result = read(make())
@@ -174,7 +164,7 @@ def test_language_programs_are_read_by_linuxcnc(linuxcnc):
         assert result.reader == expected, name
 
 
-def test_native_oracle_programs_agree(linuxcnc):
+def test_native_oracle_programs_agree(linuxcnc_interpreter):
     """The programs test_gcode_linuxcnc.py checks the native reader's moves with (cycles, G92,
     dwells, turns, units) and its random ones, those both readers read."""
     rng = np.random.default_rng(7)
@@ -237,7 +227,7 @@ def language_programs(draw) -> str:
 
 @settings(max_examples=25)
 @given(text=st.one_of(programs(), language_programs()))
-def test_random_programs_agree(linuxcnc, text):
+def test_random_programs_agree(linuxcnc_interpreter, text):
     try:
         native = parse(text, reader="native")
     except GCodeError:
@@ -248,13 +238,13 @@ def test_random_programs_agree(linuxcnc, text):
 # ---------------------------------------------------------------------------------------------
 # What only LinuxCNC reads, worked out by hand
 # ---------------------------------------------------------------------------------------------
-def test_parameters_and_expressions(linuxcnc):
+def test_parameters_and_expressions(linuxcnc_interpreter):
     tp = parse("#1=5\nG1 X[#1*2] Y[#1-7] F[#1*12]\nM2", reader="linuxcnc")
     np.testing.assert_allclose(tp.end_mm, [[10.0, -2.0, 0.0]])
     assert tp.line.tolist() == [2] and tp.feed_mm_s.tolist() == pytest.approx([1.0])
 
 
-def test_subroutine_called_twice(linuxcnc):
+def test_subroutine_called_twice(linuxcnc_interpreter):
     text = "o100 sub\nG91 G1 X1 Y2 F60\nG90\no100 endsub\nG0 X0 Y0\no100 call\no100 call\nM2"
     tp = parse(text, reader="linuxcnc")
     assert tp.kind.tolist() == [MotionKind.RAPID, MotionKind.LINEAR, MotionKind.LINEAR]
@@ -262,7 +252,7 @@ def test_subroutine_called_twice(linuxcnc):
     assert tp.line.tolist() == [5, 2, 2]  # the subroutine's line, at each call
 
 
-def test_g81_cycle(linuxcnc):
+def test_g81_cycle(linuxcnc_interpreter):
     """G98 G81 from Z5 to a hole at X10 Y5, R2, Z-3: over the hole, down to R, feed to the
     bottom, back up to the initial Z; all in exact-path mode."""
     tp = parse("G0 X0 Y0 Z5\nG64 P0.1\nG98 G81 X10 Y5 R2 Z-3 F60\nG80\nM2", reader="linuxcnc")
@@ -274,7 +264,7 @@ def test_g81_cycle(linuxcnc):
     assert (tp.path_mode[1:] == PathMode.EXACT_PATH).all()
 
 
-def test_cutter_compensation_of_a_square(linuxcnc, tmp_path):
+def test_cutter_compensation_of_a_square(linuxcnc_interpreter, tmp_path):
     """A 20 mm square climbed clockwise with G41 and a tool of diameter 4 (tool table): the
     sides run 2 mm outside it, and the outside corners are arcs of radius 2 about the corners."""
     table = tmp_path / "tool.tbl"
@@ -295,14 +285,14 @@ def test_cutter_compensation_of_a_square(linuxcnc, tmp_path):
     np.testing.assert_allclose(plain.end_mm[plain.line == 5], [[20, 20, 0]])
 
 
-def test_tool_length_offset(linuxcnc, tmp_path):
+def test_tool_length_offset(linuxcnc_interpreter, tmp_path):
     table = tmp_path / "tool.tbl"
     table.write_text("T1 P1 D0 Z5 ;\n")
     tp = parse("G43 H1\nG0 X1 Z2\nG49\nG0 Z2\nM2", reader="linuxcnc", tool_table=table)
     np.testing.assert_allclose(tp.end_mm, [[1, 0, 7], [1, 0, 2]])
 
 
-def test_inch_program(linuxcnc):
+def test_inch_program(linuxcnc_interpreter):
     tp = parse("G20\nG1 X1 Y2 F10\nG64 P0.001\nG1 X0\nM2", reader="linuxcnc")
     np.testing.assert_allclose(tp.end_mm, [[25.4, 50.8, 0.0], [0.0, 50.8, 0.0]])
     assert tp.feed_mm_s == pytest.approx([10 * 25.4 / 60] * 2, rel=1e-12)
@@ -334,19 +324,19 @@ def test_default_tool_table_is_linuxcnc_configurations():
         ("G38.2 Z-1 F10\nM2", 1, r"probing \(G38.n\) has no tool path without a probe"),
     ],
 )
-def test_refusals_name_line_and_reason(linuxcnc, text, line, reason):
+def test_refusals_name_line_and_reason(linuxcnc_interpreter, text, line, reason):
     with pytest.raises(GCodeError, match=f"^<string>:{line}: {reason}") as err:
         parse(text, reader="linuxcnc", source=None)
     assert "\n" not in str(err.value)
 
 
-def test_endless_loop_stops_at_the_move_limit(linuxcnc):
+def test_endless_loop_stops_at_the_move_limit(linuxcnc_interpreter):
     text = "o100 while [1]\nG1 X1 F10\nG1 X0\no100 endwhile\nM2"
     with pytest.raises(GCodeError, match=r"^<string>:[23]: more than 1000 canonical moves"):
         parse(text, reader="linuxcnc", max_moves=1000)
 
 
-def test_endless_loop_without_moves_stops_at_the_time_limit(linuxcnc):
+def test_endless_loop_without_moves_stops_at_the_time_limit(linuxcnc_interpreter):
     """The interpreter checks its clock about every 2 s: with 8 s it stops itself in time."""
     t0 = time.monotonic()
     with pytest.raises(GCodeError, match=r"^<string>:\d+: .* time limit of 8 s"):
@@ -354,7 +344,7 @@ def test_endless_loop_without_moves_stops_at_the_time_limit(linuxcnc):
     assert time.monotonic() - t0 < 8.0
 
 
-def test_interpreter_is_killed_at_the_time_limit(linuxcnc, monkeypatch):
+def test_interpreter_is_killed_at_the_time_limit(linuxcnc_interpreter, monkeypatch):
     monkeypatch.setattr(_interp, "_CHILD_MARGIN_S", -100.0)  # the child would not stop itself
     t0 = time.monotonic()
     with pytest.raises(GCodeError, match="did not finish within 2 s and was stopped"):
@@ -369,14 +359,14 @@ def test_time_limit_grows_with_the_file():
     )
 
 
-def test_binary_file(linuxcnc, tmp_path):
+def test_binary_file(linuxcnc_interpreter, tmp_path):
     path = tmp_path / "part.bin"
     path.write_bytes(b"G0 X1\n" + bytes(range(256)))
     with pytest.raises(GCodeError, match=r"part.bin:2: binary data \(NUL bytes\)"):
         parse_file(path, reader="linuxcnc")
 
 
-def test_missing_subroutine_file_is_looked_up_beside_the_program(linuxcnc, tmp_path):
+def test_missing_subroutine_file_is_looked_up_beside_the_program(linuxcnc_interpreter, tmp_path):
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "square.ngc").write_text(
         "o<square> sub\nG1 X#1 F60\no<square> endsub\nM2\n"
@@ -414,7 +404,7 @@ def test_bad_reader_arguments():
         parse("G0 X1", reader="linuxcnc", dwell_p_unit="ms")
 
 
-def test_auto_reports_the_reader(linuxcnc):
+def test_auto_reports_the_reader(linuxcnc_interpreter):
     assert read("G0 X1\nG1 Y1 F60").reader == "native"
     result = read("#1=2\nG0 X#1\nM2")
     assert result.reader == "linuxcnc"
