@@ -441,3 +441,21 @@ def test_programs_linuxcnc_refuses_give_one_line_per_error(tmp_path, capsys, tex
     err = capsys.readouterr().err
     assert err.startswith(f"{prog}:") and needle in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+def test_tool_table_gives_the_tools_of_a_programs_t_words(tmp_path, capsys):
+    prog = tmp_path / "tool.ngc"
+    # G41 with tool 2 of diameter 4 on a 10 mm line along X: the tool runs 2 mm to its left
+    prog.write_text("G21 G90 F600\nT2 M6\nG41 D2 G1 X0 Y5\nG1 X10\nG40 G1 X10 Y20\nM2\n")
+    assert main(["estimate", str(prog)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"{prog}:2: Requested tool 2 not found in the tool table")
+    assert "--tool-table" in err and len(err.splitlines()) == 1
+    table = tmp_path / "tool.tbl"
+    table.write_text("T1 P1 D0 Z0 ;\nT2 P2 D4 Z0 ;\n")
+    args = ["estimate", str(prog), "--tool-table", str(table), "--json", "--method", "cam"]
+    assert main(args) == 0
+    assert json.loads(capsys.readouterr().out)["reader"] == "linuxcnc"
+    assert main(["estimate", str(prog), "--tool-table", str(tmp_path / "none.tbl")]) == 2
+    assert capsys.readouterr().err.strip() == f"{tmp_path / 'none.tbl'}: no such tool table file"

@@ -25,8 +25,6 @@ failed there under ``NCTWIN_REQUIRE_LINUXCNC=1`` (``make test``).
 
 from __future__ import annotations
 
-import inspect
-import json
 import time
 from pathlib import Path
 
@@ -39,7 +37,6 @@ from test_gcode_linuxcnc import PROGRAMS, _random_program
 
 from nctwin import MotionKind, PathMode, Toolpath
 from nctwin.gcode import (
-    LINUXCNC_TOOL_TABLE,
     GCodeError,
     _interp,
     interpreter_available,
@@ -298,13 +295,6 @@ def test_inch_program(linuxcnc_interpreter):
     assert tp.feed_mm_s == pytest.approx([10 * 25.4 / 60] * 2, rel=1e-12)
     assert tp.path_mode.tolist() == [PathMode.DEFAULT, PathMode.BLEND]
     assert tp.blend_tol_mm[1] == pytest.approx(0.0254, rel=1e-12)
-
-
-def test_default_tool_table_is_linuxcnc_configurations():
-    """The reader's default tool table is the one nctwin's LinuxCNC instances are given."""
-    from nctwin.kernel import linuxcnc as kernel
-
-    assert f'"tool.tbl": {json.dumps(LINUXCNC_TOOL_TABLE)}' in inspect.getsource(kernel.record)
 
 
 # ---------------------------------------------------------------------------------------------

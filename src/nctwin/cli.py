@@ -77,6 +77,7 @@ examples:
   nctwin estimate part.nc --machine linuxcnc_sim --method bilstm
   nctwin estimate part.nc --machine own_machine.toml
   nctwin estimate part.ngc --reader linuxcnc       subroutines, #parameters, G41/G42
+  nctwin estimate part.ngc --tool-table tool.tbl   the tools of its T words (LinuxCNC .tbl)
   cat part.nc | nctwin estimate -"""
 
 SIMULATE_EXAMPLES = """\
@@ -227,6 +228,12 @@ def _program_args(p: argparse.ArgumentParser) -> None:
         "(LinuxCNC's own interpreter: subroutines, parameters, cutter compensation; needs make "
         "linuxcnc) or auto (native, LinuxCNC's interpreter for what only it reads; default)",
     )
+    p.add_argument(
+        "--tool-table",
+        metavar="TBL",
+        help="LinuxCNC tool table (.tbl) for tool lengths (G43) and diameters (G41/G42 D) when "
+        "LinuxCNC's interpreter reads the program (default: one tool, T1, of diameter 0)",
+    )
 
 
 def _format_duration(seconds: float) -> str:
@@ -293,6 +300,11 @@ def _load(
     kwargs = {"source": source, "units": args.input_units, "dwell_p_unit": args.dwell_p_unit}
     if args.program != "-" and args.reader != "native":
         kwargs["folder"] = Path(args.program).resolve().parent
+    if args.tool_table is not None:
+        table = Path(args.tool_table)
+        if not table.is_file():
+            raise InputError(f"{args.tool_table}: no such tool table file")
+        kwargs["tool_table"] = args.tool_table
     result = read(text, reader=args.reader, **kwargs)
     tp = result.toolpath
     if not ((tp.lengths_mm > 0).any() or (tp.dwell_s > 0).any()):

@@ -400,6 +400,11 @@ def _reason(message: str, name: str, program: Path, folder) -> str:
             f": the {bad.group(1).upper()} axis is not on this machine (nctwin's LinuxCNC"
             " machines have the axes X, Y and Z only)"
         )
+    if re.match(r"Requested tool \d+ not found in the tool table", message):
+        message += (
+            ": give the machine's LinuxCNC tool table (tool_table=, nctwin --tool-table FILE);"
+            " nctwin's own holds T1 only, of diameter 0"
+        )
     return message
 
 

@@ -58,7 +58,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..gcode import GCodeError, dump, parse
+from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, dump, parse
 from ..machine import MachineProfile
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
@@ -326,7 +326,7 @@ def record(
         files = {
             "sim.ini": ini,
             "sim.hal": hal_text(),
-            "tool.tbl": "T1 P1 D0 Z0 ;\n",
+            "tool.tbl": LINUXCNC_TOOL_TABLE,  # the interpreter reader's default too
             "program.ngc": program,
             "display.py": _DISPLAY.read_text(),
         }
