@@ -153,6 +153,7 @@ def path_control(tp: Toolpath, machine: MachineProfile) -> str:
 #: were put on whole servo periods, and with the near-reversal threshold it had then measured.
 PLANNER_RULES = {
     "all": {},
+    "no arc blends": {"arc_blends": False},
     "no kinks": {"kinks": False},
     "largest arcs": {"sized_arcs": False},
     "stops off periods": {"stop_periods": "off"},
@@ -168,8 +169,9 @@ PLANNER_RULES = {
 def planner_ablation(
     programs: dict[str, tuple[str, Toolpath, float]], machine: MachineProfile
 ) -> pd.DataFrame:
-    """The blend-arc planner with and without its rules for nearly tangent junctions, for the
-    size of blend arcs and for stops on whole servo periods (:data:`PLANNER_RULES`).
+    """The blend-arc planner with and without its rules for blends at programmed arcs, for
+    nearly tangent junctions, for the size of blend arcs and for stops on whole servo periods
+    (:data:`PLANNER_RULES`).
 
     The planner learns nothing from recordings, so for it the training sets are held-out
     programs: a check of its rules on programs that were not used to find them.
