@@ -89,6 +89,19 @@ def test_checkpoint_round_trip_and_cache_hit():
     assert d.path != a.path
 
 
+def test_cache_is_keyed_by_the_cpu_kernels(monkeypatch):
+    """A network trained on other CPU kernels (AVX-512 outside make's AVX2 pins) rounds
+    differently: it gets a checkpoint of its own, never the other's."""
+    import torch
+
+    xs, ys = _data()
+    a = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, name="t", progress=False)
+    other = "AVX512" if torch.backends.cpu.get_cpu_capability() != "AVX512" else "AVX2"
+    monkeypatch.setattr(torch.backends.cpu, "get_cpu_capability", lambda: other)
+    b = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, name="t", progress=False)
+    assert b.path != a.path and a.path.exists() and b.path.exists()
+
+
 def test_scaling_uses_training_programs_only():
     xs, ys = _data()
     train_idx, val_idx = _split(len(xs), CFG)

@@ -28,10 +28,12 @@ Determinism
     thread count), and restores both settings when it returns. The same data and configs give
     the same weights, bit for bit, on one machine.
 Checkpoints
-    ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config and
-    the training config, written atomically (temporary file, then ``os.replace``) and read with
-    ``torch.load(..., weights_only=True)``: the file holds tensors and plain Python values only,
-    never pickled objects.
+    ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
+    the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
+    ``AVX512`` on such a CPU outside it: their rounding differs, so a network trained outside
+    ``make`` is never reused by a chapter run through it), written atomically (temporary file,
+    then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
+    tensors and plain Python values only, never pickled objects.
 """
 
 from __future__ import annotations
@@ -346,7 +348,8 @@ def fit(
         )
     val_key = data_hash(*validation) if validation is not None else None
     key = {"data": data_hash(xs, ys), "validation": val_key, "model": model_config.to_dict(),
-           "train": train_config.to_dict()}  # fmt: skip
+           "train": train_config.to_dict(),
+           "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
     path = cache_path("models", name, content_key(key), ".pt")
