@@ -142,6 +142,18 @@ def test_generated_programs_agree(linuxcnc_interpreter, text):
     assert_agree(*_both(text))
 
 
+def test_g94_clears_the_feed_in_both_readers(linuxcnc_interpreter):
+    """G94 runs before the F of its line and sets the feed to 0 (LinuxCNC's convert_feed_mode):
+    the rapid after it has no feed, a feed move needs a new F, and an F on its own line wins."""
+    text = "G21 F600\nG1 X1\nG94\nG0 X2\nG94 F300 G1 X3\n"
+    native, linuxcnc = _both(text)
+    assert_agree(native, linuxcnc)
+    np.testing.assert_array_equal(native.feed_mm_s, [10.0, np.nan, 5.0])
+    for reader in ("native", "linuxcnc"):
+        with pytest.raises(GCodeError, match=r"^<string>:3: "):
+            parse("G21 F600\nG1 X1\nG94 G1 X2\n", reader=reader)
+
+
 def test_fanuc_dwell_is_native_only(linuxcnc_interpreter):
     """ISO 10791-7's test piece dwells with Fanuc's ``G04 X0.5``: the native reader reads it
     (its docstring says so), LinuxCNC refuses it; with ``G4 P0.5`` the two agree."""

@@ -32,7 +32,8 @@ in ``convert_length_units``).
 * Offsets G92, G92.1 (clears them and zeros parameters 5211-5213), G92.2 (clears them, keeps the
   parameters), G92.3 (restores them from the parameters, which start at zero). Positions are
   machine positions: program coordinates plus the G92 offset.
-* Modal state: G17/G18/G19, G20/G21 (converted to mm), G90/G91, G90.1/G91.1, G94, G98/G99, F.
+* Modal state: G17/G18/G19, G20/G21 (converted to mm), G90/G91, G90.1/G91.1, G94 (which runs
+  before the F of its line and clears the feed, as LinuxCNC's does), G98/G99, F.
   A G80 beside another motion code of its line gives way to it, as in LinuxCNC (``read_g``).
 * Prologue codes kept as state with no motion: G40, G43 (H; tool lengths are taken as zero),
   G49, G53 (machine coordinates, ignoring G92; work offsets are taken as zero), G54-G59.3, G80,

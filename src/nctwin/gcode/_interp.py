@@ -59,8 +59,8 @@ What differs from the native reader (by design)
   (which are not instrumented) a line's state is the one the next reporting line gives.
 * The tool starts at machine zero (LinuxCNC's preview starts there); ``start_mm`` is refused.
 * G94 sets LinuxCNC's feed to 0 (``convert_feed_mode``): the blocks after it carry NaN (no feed
-  set) up to the next F, and a feed move there is LinuxCNC's error; the native reader keeps the
-  F in force across a G94.
+  set) up to the next F, and a feed move there is LinuxCNC's error; the native reader does the
+  same.
 
 Limits: at most :data:`MAX_MOVES` canonical moves (``max_moves``), and a wall-clock limit of
 :data:`TIMEOUT_BASE_S` plus :data:`TIMEOUT_S_PER_MB` per MB of program (``timeout_s``), after

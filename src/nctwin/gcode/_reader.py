@@ -25,6 +25,7 @@ from ._modal import (
     _ARCDIST,
     _DIST,
     _DWELLS,
+    _FEEDMODE,
     _G_CODES,
     _G_FOREIGN,
     _G_GROUPS,
@@ -189,10 +190,11 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
     dwell_line = G[_NONMODAL] == 40
     g92_line = G[_NONMODAL] == 920
 
-    # F runs before the line's G20/G21, and a change of units keeps the feed in mm/min
+    # F runs before the line's G20/G21, and a change of units keeps the feed in mm/min; G94
+    # runs before F and sets the feed to 0, no feed (LinuxCNC's convert_feed_mode)
     errors.at_lines(has["F"] & (W["F"] <= 0), "feed rate F must be > 0")
     scale_before = np.concatenate([[MM_PER_INCH if inch else 1.0], scale[:-1]])
-    feed = _ffill(has["F"], W["F"] * scale_before / 60.0, np.nan)
+    feed = _ffill(has["F"] | (G[_FEEDMODE] == 940), W["F"] * scale_before / 60.0, np.nan)
 
     errors.at_lines(has["H"] & (G[_TLO] != 430), "H word without G43")
     errors.at_lines(g64 & ((W["P"] < 0) | (W["Q"] < 0)), "G64 P and Q must be >= 0")
