@@ -25,6 +25,7 @@ import pandas as pd
 from ..learn.train import TrainConfig, Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
+from ..report.claims import claims_by_seed
 from ..report.tables import Claim, side_by_side
 from .chien2023 import fit_seeds
 from .denkena2020_bench import (
@@ -498,35 +499,6 @@ def seed_table(
          "lstm_lower_pct": _lower_pct(t, "cutting_")}
         for s, t in tables.items()
     ])  # fmt: skip
-
-
-def claims_by_seed(ensemble: list[Claim], per_seed: dict[int, list[Claim]]) -> pd.DataFrame:
-    """Each claim's value and verdict for the ensemble (the rule) beside every seed's own.
-
-    Parameters
-    ----------
-    ensemble : list of Claim
-        :func:`claims` of the mean of the seeds' predictions.
-    per_seed : dict
-        Seed -> :func:`claims` of that seed's networks alone.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per claim: ``id``, ``op``, ``threshold``, ``ensemble`` (value), ``holds``,
-        ``seed_<s>`` (each seed's value), ``seed_min``, ``seed_max``, ``seed_std`` (sample
-        standard deviation) and ``seeds_holding`` (how many seeds' own claims hold).
-    """
-    rows = []
-    for k, c in enumerate(ensemble):
-        values = np.array([per_seed[s][k].value for s in per_seed], dtype=float)
-        by_seed = {f"seed_{s}": v for s, v in zip(per_seed, values, strict=True)}
-        rows.append({"id": c.id, "op": c.op, "threshold": c.threshold, "ensemble": c.value,
-                     "holds": c.holds, **by_seed,
-                     "seed_min": values.min(), "seed_max": values.max(),
-                     "seed_std": values.std(ddof=1) if len(values) > 1 else np.nan,
-                     "seeds_holding": sum(per_seed[s][k].holds for s in per_seed)})  # fmt: skip
-    return pd.DataFrame(rows)
 
 
 def kind_means(table: pd.DataFrame, paper2: pd.DataFrame) -> pd.DataFrame:

@@ -13,7 +13,7 @@ one another; one torch thread each, so the weights do not depend on the worker o
 The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and
 are the same for every training seed. The claims judge the **mean of the seeds' predictions**
 (:func:`ensemble_um`, :func:`ensemble_transfer`); :func:`seed_runs` and
-:func:`nctwin.chapters.denkena2020.claims_by_seed` give every seed's own numbers.
+:func:`nctwin.report.claims.claims_by_seed` give every seed's own numbers.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 
 from ..learn.train import Trained, TrainingDivergedError
+from ..report.claims import claims_by_seed
 from ..runner import run_tasks
-from .denkena2020 import claims_by_seed
 from .zhang2023 import (
     BATCH_RUNS,
     SurfaceData,

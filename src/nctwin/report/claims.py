@@ -20,11 +20,12 @@ from __future__ import annotations
 from collections.abc import Iterable
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from .tables import Claim, format_table, write_claims
 
-__all__ = ["LINE", "VERDICTS", "Claim", "format_claim", "report_claims"]
+__all__ = ["LINE", "VERDICTS", "Claim", "claims_by_seed", "format_claim", "report_claims"]
 
 #: The line printed per claim: ``str.format`` fields ``verdict``, ``id``, ``text``, ``value``,
 #: ``op`` and ``threshold``.
@@ -100,3 +101,32 @@ def report_claims(
     else:
         for c in claims:
             print(format_claim(c, line, verdicts))
+
+
+def claims_by_seed(ensemble: list[Claim], per_seed: dict[int, list[Claim]]) -> pd.DataFrame:
+    """Each claim's value and verdict for the ensemble (the rule) beside every seed's own.
+
+    Parameters
+    ----------
+    ensemble : list of Claim
+        A chapter's claims on the mean of the seeds' predictions (the rule).
+    per_seed : dict
+        Seed -> The same claims, in the same order, of that seed's networks alone.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per claim: ``id``, ``op``, ``threshold``, ``ensemble`` (value), ``holds``,
+        ``seed_<s>`` (each seed's value), ``seed_min``, ``seed_max``, ``seed_std`` (sample
+        standard deviation) and ``seeds_holding`` (how many seeds' own claims hold).
+    """
+    rows = []
+    for k, c in enumerate(ensemble):
+        values = np.array([per_seed[s][k].value for s in per_seed], dtype=float)
+        by_seed = {f"seed_{s}": v for s, v in zip(per_seed, values, strict=True)}
+        rows.append({"id": c.id, "op": c.op, "threshold": c.threshold, "ensemble": c.value,
+                     "holds": c.holds, **by_seed,
+                     "seed_min": values.min(), "seed_max": values.max(),
+                     "seed_std": values.std(ddof=1) if len(values) > 1 else np.nan,
+                     "seeds_holding": sum(per_seed[s][k].holds for s in per_seed)})  # fmt: skip
+    return pd.DataFrame(rows)
