@@ -1,12 +1,24 @@
 """Models and the shared training loop: seeded, early stopping, checkpoints, scaling."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from nctwin import paths
 from nctwin.learn.models import ModelConfig, build
-from nctwin.learn.train import Scaler, TrainConfig, _split, fit, load_checkpoint
+from nctwin.learn.train import (
+    Scaler,
+    TrainConfig,
+    _Programs,
+    _split,
+    _windows,
+    fit,
+    load_checkpoint,
+)  # fmt: skip
 
 
 @pytest.fixture(autouse=True)
@@ -72,6 +84,54 @@ def test_early_stopping_keeps_best_epoch():
     assert epochs < 300
     assert epochs == t.best_epoch + cfg.patience
     assert t.history["val"][t.best_epoch - 1] == min(t.history["val"])
+
+
+def test_converged_means_early_stopping_ended_the_run():
+    xs, ys = _data()
+    cfg = TrainConfig(seed=0, max_epochs=300, patience=2, batch_size=4, window_lines=32,
+                      learning_rate=0.3)  # fmt: skip
+    stopped = fit(ModelConfig(n_inputs=2, hidden=4), cfg, xs, ys, cache=False, progress=False)
+    assert stopped.converged  # best epoch + patience = epochs run < 300
+    capped = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, cache=False, progress=False)
+    # 8 epochs, patience 3: converged only if the best epoch is below 8 - 3 = 5
+    assert capped.converged == (capped.best_epoch < 5)
+
+
+def test_learning_rate_decays_at_a_stall_before_a_stall_stops():
+    xs, ys = _data()
+    cfg = TrainConfig(seed=0, max_epochs=300, patience=2, batch_size=4, window_lines=32,
+                      learning_rate=0.3)  # fmt: skip
+    plain = fit(ModelConfig(n_inputs=2, hidden=4), cfg, xs, ys, cache=False, progress=False)
+    decayed = fit(ModelConfig(n_inputs=2, hidden=4), replace(cfg, lr_decays=1), xs, ys,
+                  cache=False, progress=False)  # fmt: skip
+    n = len(plain.history["val"])
+    # the same run up to the first stall; then a tenth of the rate, and at least another stall
+    assert decayed.history["val"][:n] == plain.history["val"]
+    assert len(decayed.history["val"]) >= n + cfg.patience and decayed.converged
+    assert "lr_decays" not in cfg.to_dict()  # keys of checkpoints without decays unchanged
+    with pytest.raises(ValueError, match="lr_decays"):
+        TrainConfig(lr_decays=-1)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    lengths=st.lists(st.integers(1, 30), min_size=1, max_size=6),
+    w=st.integers(1, 12),
+    seed=st.integers(0, 2**16),
+)
+def test_batch_of_windows_is_the_windows_stacked_by_hand(lengths, w, seed):
+    rng = np.random.default_rng(seed)
+    xs = [rng.normal(size=(n, 3)) for n in lengths]
+    ys = [rng.normal(size=(n, 2)) for n in lengths]
+    ys[0][rng.integers(lengths[0]), rng.integers(2)] = np.nan  # a missing target
+    windows = np.array(_windows(lengths, w, rng))
+    x, y, m = _Programs(xs, ys).batch(windows, w)
+    for i, (p, s, v) in enumerate(windows):  # by hand: the window's rows, then zeros
+        t = ys[p][s : s + v].astype(np.float32)
+        np.testing.assert_array_equal(x[i, :v].numpy(), xs[p][s : s + v].astype(np.float32))
+        np.testing.assert_array_equal(m[i, :v].numpy(), np.isfinite(t))
+        np.testing.assert_array_equal(y[i, :v].numpy(), np.nan_to_num(t))
+        assert not x[i, v:].any() and not y[i, v:].any() and not m[i, v:].any()
 
 
 def test_checkpoint_round_trip_and_cache_hit():

@@ -189,7 +189,7 @@ def convergence(models: dict[str, Sequence[Trained]]) -> pd.DataFrame:
             rows.append({"network": name, "seed": cfg.seed, "best_epoch": m.best_epoch,
                          "epochs_run": len(m.history["val"]), "max_epochs": cfg.max_epochs,
                          "patience": cfg.patience,
-                         "converged": m.best_epoch < cfg.max_epochs - cfg.patience})  # fmt: skip
+                         "converged": m.converged})  # fmt: skip
     return pd.DataFrame(rows)
 
 

@@ -477,8 +477,8 @@ def seed_table(
     tables: dict[int, pd.DataFrame], nets: dict[int, dict[str, Trained]]
 ) -> pd.DataFrame:
     """One row per seed: its networks' best and last epochs, whether early stopping ended them
-    (``converged_*``: the best epoch lies more than ``patience`` epochs below the cap, as in
-    :func:`nctwin.chapters.chien2023.convergence`), and its own cutting-window scores.
+    (``converged_*``, :attr:`nctwin.learn.train.Trained.converged`), and its own cutting-window
+    scores.
 
     Parameters
     ----------
@@ -487,14 +487,10 @@ def seed_table(
     nets : dict
         Seed -> ``{"X": Trained, ...}``.
     """
-
-    def converged(n: Trained) -> bool:
-        return n.best_epoch < n.train_config.max_epochs - n.train_config.patience
-
     return pd.DataFrame([
         {"seed": s, **{f"best_epoch_{a}": n.best_epoch for a, n in nets[s].items()},
          **{f"epochs_{a}": len(n.history["train"]) for a, n in nets[s].items()},
-         **{f"converged_{a}": converged(n) for a, n in nets[s].items()},
+         **{f"converged_{a}": n.converged for a, n in nets[s].items()},
          "mean_lstm_rmse_n": t["lstm_cutting_rmse_n"].mean(),
          "lstm_lower_pct": _lower_pct(t, "cutting_")}
         for s, t in tables.items()

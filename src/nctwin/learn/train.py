@@ -96,6 +96,10 @@ class TrainConfig:
         Adam, or stochastic gradient descent with ``momentum`` (Zhang et al. 2023, eq. 14).
     momentum : float
         Momentum :math:`\beta` of ``"sgd"``, in [0, 1).
+    lr_decays : int
+        Times the learning rate is divided by 10 when the validation loss has not improved for
+        ``patience`` epochs, before such a stall stops the training (0: the first stall stops
+        it).
     """
 
     seed: int = 0
@@ -109,6 +113,7 @@ class TrainConfig:
     log_inputs: tuple[int, ...] = field(default_factory=tuple)
     optimiser: str = "adam"
     momentum: float = 0.0
+    lr_decays: int = 0
 
     def __post_init__(self) -> None:
         if self.loss not in ("rmse", "mse"):
@@ -122,12 +127,14 @@ class TrainConfig:
         for name in ("max_epochs", "patience", "batch_size", "window_lines"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
+        if self.lr_decays < 0:
+            raise ValueError(f"lr_decays = {self.lr_decays!r} is out of range: allowed >= 0")
 
     def to_dict(self) -> dict:
         d = asdict(self)
         d["log_inputs"] = list(self.log_inputs)
         # left out at their defaults, so that checkpoints made before they existed keep their keys
-        for name, default in (("optimiser", "adam"), ("momentum", 0.0)):
+        for name, default in (("optimiser", "adam"), ("momentum", 0.0), ("lr_decays", 0)):
             if d[name] == default:
                 del d[name]
         return d
@@ -209,6 +216,14 @@ class Trained:
     train_seconds: float
     path: Path
 
+    @property
+    def converged(self) -> bool:
+        """Whether early stopping, not the epoch cap, ended the training: it stopped before
+        ``max_epochs`` (the validation loss had not improved for ``patience`` epochs, after the
+        last of the ``lr_decays``). Without decays, the best epoch lies more than ``patience``
+        epochs below ``max_epochs``."""
+        return len(self.history["train"]) < self.train_config.max_epochs
+
     def predict(self, x: np.ndarray) -> np.ndarray:
         """Outputs for one program, shape (N, n_outputs), from inputs (N, n_inputs).
 
@@ -283,18 +298,31 @@ def _windows(lengths: Sequence[int], w: int, rng: np.random.Generator | None):
     return out
 
 
-def _batch(zx, zy, windows, w):
-    """Stack windows into (B, w, n) inputs, targets and a mask of valid, finite targets."""
-    b = len(windows)
-    x = np.zeros((b, w, zx[0].shape[1]), dtype=np.float32)
-    y = np.zeros((b, w, zy[0].shape[1]), dtype=np.float32)
-    m = np.zeros((b, w, zy[0].shape[1]), dtype=bool)
-    for i, (p, s, v) in enumerate(windows):
-        x[i, :v] = zx[p][s : s + v]
-        t = zy[p][s : s + v]
-        m[i, :v] = np.isfinite(t)
-        y[i, :v] = np.nan_to_num(t)
-    return torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(m)
+class _Programs:
+    """Programs stacked once into float32 rows, so that a batch of windows is one gather.
+
+    Parameters
+    ----------
+    zx, zy : sequences of ndarray, shapes (N_i, n_inputs) and (N_i, n_outputs)
+        Scaled programs.
+    """
+
+    def __init__(self, zx: Sequence[np.ndarray], zy: Sequence[np.ndarray]) -> None:
+        self.x = np.concatenate(zx).astype(np.float32)
+        self.y = np.concatenate(zy).astype(np.float32)
+        self.start = np.cumsum([0, *(len(x) for x in zx)])[:-1]
+
+    def batch(self, windows: np.ndarray, w: int):
+        """Stack ``windows`` (B, 3) of (program, start, valid) into (B, w, n) inputs, targets
+        and a mask of valid, finite targets; rows past a window's valid length are zero."""
+        steps = np.arange(w)
+        valid = steps < windows[:, 2:3]
+        rows = np.where(valid, self.start[windows[:, 0:1]] + windows[:, 1:2] + steps, 0)
+        x, y = self.x[rows], self.y[rows]  # copies
+        x[~valid] = 0.0
+        m = valid[..., None] & np.isfinite(y)
+        y[~m] = 0.0
+        return torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(m)
 
 
 def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) -> torch.Tensor:
@@ -403,12 +431,12 @@ def _train(
         optimiser = torch.optim.SGD(model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum)
     else:
         optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
-    val_windows = _windows([len(zx[i]) for i in val_idx], w, None)
-    vx, vy, vm = _batch([zx[i] for i in val_idx], [zy[i] for i in val_idx], val_windows, w)
+    val_programs = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
+    vx, vy, vm = val_programs.batch(np.array(_windows([len(zx[i]) for i in val_idx], w, None)), w)
     tx = [zx[i] for i in train_idx]
-    ty = [zy[i] for i in train_idx]
+    programs = _Programs(tx, [zy[i] for i in train_idx])
     history: dict[str, list[float]] = {"train": [], "val": []}
-    best, best_state, best_epoch, stale = math.inf, None, 0, 0
+    best, best_state, best_epoch, stale, decays = math.inf, None, 0, 0, 0
     # shown after 5 s only, so that short runs leave no text in executed notebooks; ``disable``
     # is passed only to hide it, so that TQDM_DISABLE=1 in the environment hides it too
     bar = tqdm(
@@ -421,11 +449,11 @@ def _train(
     )
     for epoch in bar:
         model.train()
-        windows = _windows([len(x) for x in tx], w, rng)
-        order = rng.permutation(len(windows))
+        windows = np.array(_windows([len(x) for x in tx], w, rng))
+        windows = windows[rng.permutation(len(windows))]
         total, count = 0.0, 0
-        for b in range(0, len(order), cfg.batch_size):
-            bx, by, bm = _batch(tx, ty, [windows[i] for i in order[b : b + cfg.batch_size]], w)
+        for b in range(0, len(windows), cfg.batch_size):
+            bx, by, bm = programs.batch(windows[b : b + cfg.batch_size], w)
             loss = _loss(model(bx), by, bm, cfg.loss)
             optimiser.zero_grad()
             loss.backward()
@@ -443,7 +471,11 @@ def _train(
         else:
             stale += 1
             if stale >= cfg.patience:
-                break
+                if decays == cfg.lr_decays:
+                    break
+                decays, stale = decays + 1, 0
+                for group in optimiser.param_groups:
+                    group["lr"] /= 10.0
     bar.close()
     if best_state is None:
         raise TrainingDivergedError(
