@@ -1,7 +1,5 @@
 """Models and the shared training loop: seeded, early stopping, checkpoints, scaling."""
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 import torch
@@ -95,22 +93,6 @@ def test_converged_means_early_stopping_ended_the_run():
     capped = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, cache=False, progress=False)
     # 8 epochs, patience 3: converged only if the best epoch is below 8 - 3 = 5
     assert capped.converged == (capped.best_epoch < 5)
-
-
-def test_learning_rate_decays_at_a_stall_before_a_stall_stops():
-    xs, ys = _data()
-    cfg = TrainConfig(seed=0, max_epochs=300, patience=2, batch_size=4, window_lines=32,
-                      learning_rate=0.3)  # fmt: skip
-    plain = fit(ModelConfig(n_inputs=2, hidden=4), cfg, xs, ys, cache=False, progress=False)
-    decayed = fit(ModelConfig(n_inputs=2, hidden=4), replace(cfg, lr_decays=1), xs, ys,
-                  cache=False, progress=False)  # fmt: skip
-    n = len(plain.history["val"])
-    # the same run up to the first stall; then a tenth of the rate, and at least another stall
-    assert decayed.history["val"][:n] == plain.history["val"]
-    assert len(decayed.history["val"]) >= n + cfg.patience and decayed.converged
-    assert "lr_decays" not in cfg.to_dict()  # keys of checkpoints without decays unchanged
-    with pytest.raises(ValueError, match="lr_decays"):
-        TrainConfig(lr_decays=-1)
 
 
 @settings(max_examples=40, deadline=None)

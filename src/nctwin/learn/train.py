@@ -27,6 +27,10 @@ Determinism
     intra-op thread (``torch.set_num_threads(1)``: summation order, hence rounding, depends on the
     thread count), and restores both settings when it returns. The same data and configs give
     the same weights, bit for bit, on one machine.
+Steps
+    A step is autograd and a :mod:`torch.optim` optimiser, except for the BP network with SGD,
+    whose step is written out (:class:`~nctwin.learn.bp_sgd.BPStep`, the same arithmetic in a
+    third of the time).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
@@ -45,6 +49,7 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +57,7 @@ import torch
 from tqdm import tqdm
 
 from ..cache import atomic_write, cache_path, content_key
+from .bp_sgd import BPStep
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
@@ -96,10 +102,6 @@ class TrainConfig:
         Adam, or stochastic gradient descent with ``momentum`` (Zhang et al. 2023, eq. 14).
     momentum : float
         Momentum :math:`\beta` of ``"sgd"``, in [0, 1).
-    lr_decays : int
-        Times the learning rate is divided by 10 when the validation loss has not improved for
-        ``patience`` epochs, before such a stall stops the training (0: the first stall stops
-        it).
     """
 
     seed: int = 0
@@ -113,7 +115,6 @@ class TrainConfig:
     log_inputs: tuple[int, ...] = field(default_factory=tuple)
     optimiser: str = "adam"
     momentum: float = 0.0
-    lr_decays: int = 0
 
     def __post_init__(self) -> None:
         if self.loss not in ("rmse", "mse"):
@@ -127,14 +128,12 @@ class TrainConfig:
         for name in ("max_epochs", "patience", "batch_size", "window_lines"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} = {getattr(self, name)!r} is out of range: allowed >= 1")
-        if self.lr_decays < 0:
-            raise ValueError(f"lr_decays = {self.lr_decays!r} is out of range: allowed >= 0")
 
     def to_dict(self) -> dict:
         d = asdict(self)
         d["log_inputs"] = list(self.log_inputs)
         # left out at their defaults, so that checkpoints made before they existed keep their keys
-        for name, default in (("optimiser", "adam"), ("momentum", 0.0), ("lr_decays", 0)):
+        for name, default in (("optimiser", "adam"), ("momentum", 0.0)):
             if d[name] == default:
                 del d[name]
         return d
@@ -219,9 +218,8 @@ class Trained:
     @property
     def converged(self) -> bool:
         """Whether early stopping, not the epoch cap, ended the training: it stopped before
-        ``max_epochs`` (the validation loss had not improved for ``patience`` epochs, after the
-        last of the ``lr_decays``). Without decays, the best epoch lies more than ``patience``
-        epochs below ``max_epochs``."""
+        ``max_epochs`` (the validation loss had not improved for ``patience`` epochs), that is,
+        the best epoch lies more than ``patience`` epochs below ``max_epochs``."""
         return len(self.history["train"]) < self.train_config.max_epochs
 
     def predict(self, x: np.ndarray) -> np.ndarray:
@@ -330,6 +328,15 @@ def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) ->
     return mse.sqrt() if kind == "rmse" else mse
 
 
+def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
+    """One optimiser step on a batch by autograd; the batch's loss, before the step."""
+    loss = _loss(model(x), y, mask, kind)
+    optimiser.zero_grad()
+    loss.backward()
+    optimiser.step()
+    return loss.detach()
+
+
 def fit(
     model_config: ModelConfig | BPConfig,
     train_config: TrainConfig,
@@ -380,6 +387,8 @@ def fit(
            "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
+    if isinstance(model_config, BPConfig) and train_config.optimiser == "sgd":
+        key["step"] = "BPStep"  # written out, not autograd: other bits than before it existed
     path = cache_path("models", name, content_key(key), ".pt")
     if cache and path.exists():
         return load_checkpoint(path)
@@ -427,16 +436,22 @@ def _train(
         model = build(model_config, generator=generator)
     if init is not None:
         model.load_state_dict(init.model.state_dict())
-    if cfg.optimiser == "sgd":
-        optimiser = torch.optim.SGD(model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum)
+    if isinstance(model, BPNetwork) and cfg.optimiser == "sgd":
+        step = BPStep(model, cfg.learning_rate, cfg.momentum, cfg.loss)
     else:
-        optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+        if cfg.optimiser == "sgd":
+            optimiser = torch.optim.SGD(
+                model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
+            )
+        else:
+            optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+        step = partial(_autograd_step, model, optimiser, cfg.loss)
     val_programs = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
     vx, vy, vm = val_programs.batch(np.array(_windows([len(zx[i]) for i in val_idx], w, None)), w)
     tx = [zx[i] for i in train_idx]
     programs = _Programs(tx, [zy[i] for i in train_idx])
     history: dict[str, list[float]] = {"train": [], "val": []}
-    best, best_state, best_epoch, stale, decays = math.inf, None, 0, 0, 0
+    best, best_state, best_epoch, stale = math.inf, None, 0, 0
     # shown after 5 s only, so that short runs leave no text in executed notebooks; ``disable``
     # is passed only to hide it, so that TQDM_DISABLE=1 in the environment hides it too
     bar = tqdm(
@@ -454,11 +469,7 @@ def _train(
         total, count = 0.0, 0
         for b in range(0, len(windows), cfg.batch_size):
             bx, by, bm = programs.batch(windows[b : b + cfg.batch_size], w)
-            loss = _loss(model(bx), by, bm, cfg.loss)
-            optimiser.zero_grad()
-            loss.backward()
-            optimiser.step()
-            total += float(loss.detach()) * len(bx)
+            total += float(step(bx, by, bm)) * len(bx)
             count += len(bx)
         model.eval()
         with torch.no_grad():
@@ -471,11 +482,7 @@ def _train(
         else:
             stale += 1
             if stale >= cfg.patience:
-                if decays == cfg.lr_decays:
-                    break
-                decays, stale = decays + 1, 0
-                for group in optimiser.param_groups:
-                    group["lr"] /= 10.0
+                break
     bar.close()
     if best_state is None:
         raise TrainingDivergedError(
