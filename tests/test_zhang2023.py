@@ -57,9 +57,19 @@ def test_transfer_metrics_by_hand() -> None:
                  "share_below_0p5um_pct": 25.0, "mean_abs_err_um": 0.75}  # fmt: skip
 
 
-def test_variant_rejects_bad_epochs() -> None:
-    with pytest.raises(ValueError, match="epochs"):
-        zh.variant_configs(325, epochs=0)
+def test_variant_and_finetuning_train_to_convergence() -> None:
+    model, cfg = zh.variant_configs(325, dropout=0.5)
+    assert model.dropout == 0.5 and model.weight_init == "uniform"
+    # the paper's 2000 epochs are the cap; early stopping ends the training
+    assert (cfg.max_epochs, cfg.patience, cfg.learning_rate) == (2000, zh.PAPER_PATIENCE, 1e-2)
+    _, ft = zh.finetune_configs(325, seed=3)
+    assert (ft.learning_rate, ft.max_epochs, ft.seed) == (3e-3, zh.FINETUNE_EPOCHS, 3)
+    assert replace(ft, learning_rate=1e-2, max_epochs=2000) == replace(cfg, seed=3)  # otherwise
+    _, tiny = zh.variant_configs(325, max_epochs=3)
+    assert tiny.patience == 3
+    for bad in ({"patience": 0}, {"max_epochs": 0}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            zh.variant_configs(325, **bad)
 
 
 def test_paper_configs_batches() -> None:
@@ -130,7 +140,7 @@ def test_parallel_training_gives_the_sequential_bits(tmp_path, monkeypatch) -> N
 
     monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "sequential"))
     data, rows = _tiny_surface(0), np.arange(400)
-    args = [(data, rows, *zh.variant_configs(7, epochs=3, seed=s), f"tiny{s}") for s in (0, 1)]
+    args = [(data, rows, *zh.variant_configs(7, max_epochs=3, seed=s), f"tiny{s}") for s in (0, 1)]
     one = [zs._train_or_none(*a) for a in args]
     # fresh workers that see a fresh cache: the networks are trained there, not loaded
     get_reusable_executor().shutdown(wait=True)

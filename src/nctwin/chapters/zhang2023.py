@@ -19,15 +19,22 @@ Configurations
 --------------
 :func:`paper_configs`
     The paper's settings: weights N(0, 1), dropout 0.5, SGD with momentum 0.8, lr 1e-5,
-    2000 epochs as the cap with early stopping after :data:`PAPER_PATIENCE` epochs without
-    improvement, MSE. The paper gives no batch size (its SGD reads as one random sample per
-    update); the default is the full batch, and :func:`batch_sweep` scores 1, 32, 256 rows and
-    the full batch, with and without dropout.
+    :data:`PAPER_EPOCHS` (2000) epochs as the cap with early stopping after
+    :data:`PAPER_PATIENCE` epochs without improvement, MSE. The paper gives no batch size (its
+    SGD reads as one random sample per update); the default is the full batch, and
+    :func:`batch_sweep` scores 1, 32, 256 rows and the full batch, with and without dropout.
 :func:`variant_configs`
     The closest variant that converges here: PyTorch's default uniform weights, SGD with
-    momentum 0.8, lr 1e-2, batches of 128 rows, ``epochs`` epochs, MSE, dropout as given.
+    momentum 0.8, lr 1e-2, batches of 128 rows, MSE, dropout as given; the same early stopping
+    and cap as the paper's settings.
 :func:`finetune_configs`
-    Fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr 1e-3.
+    Fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr 3e-3, capped
+    at :data:`FINETUNE_EPOCHS`.
+
+Every network stops once its validation loss has not improved for :data:`PAPER_PATIENCE`
+epochs, or at its cap: the paper's :data:`PAPER_EPOCHS` (2000), :data:`FINETUNE_EPOCHS` for
+fine-tuning, :data:`BATCH_SWEEP_EPOCHS` for the batch sweep's runs at 32 and 256 rows;
+:attr:`nctwin.learn.train.Trained.converged` says which ended it.
 
 Every network of the chapter is trained by :func:`nctwin.chapters.zhang2023_seeds.train_networks`
 (five seeds of those the claims judge, in parallel); this module scores them.
@@ -54,7 +61,10 @@ from .zhang2023_tables import dropout_conventions, error_histogram, transfer_met
 
 __all__ = [
     "BATCH_RUNS",
+    "BATCH_SWEEP_EPOCHS",
+    "FINETUNE_EPOCHS",
     "HIDDEN",
+    "PAPER_EPOCHS",
     "PAPER_PATIENCE",
     "SurfaceData",
     "TransferRun",
@@ -81,9 +91,19 @@ __all__ = [
 ]
 
 
-#: Early stopping of the paper's settings: epochs without a lower validation loss before
-#: training stops (the paper's 2000 epochs are the cap).
+#: Early stopping of every training of the chapter (a choice; the paper gives none): epochs
+#: without a lower validation loss before training stops.
 PAPER_PATIENCE = 100
+
+#: The paper's epochs (Sec. "Training"): the cap of training on surface 1.
+PAPER_EPOCHS = 2000
+
+#: The cap of fine-tuning (the paper gives none), far above where early stopping ends it.
+FINETUNE_EPOCHS = 10_000
+
+#: The batch sweep's cap at 32 and 256 rows per update (a time budget: 78,000 and 8,800
+#: updates, against the full batch's 2000; :func:`batch_sweep` says which runs reach it).
+BATCH_SWEEP_EPOCHS = 200
 
 
 def split(n: int, share: float, *, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -109,7 +129,7 @@ def paper_configs(
     seed: int = 0,
     dropout: float = 0.5,
     batch_rows: int | None = None,
-    epochs: int = 2000,
+    epochs: int = PAPER_EPOCHS,
 ) -> tuple[BPConfig, TrainConfig]:
     """The paper's network and training settings (see the module docstring).
 
@@ -146,30 +166,53 @@ def paper_configs(
 
 
 def variant_configs(
-    n_inputs: int, *, epochs: int, dropout: float = 0.0, seed: int = 0
+    n_inputs: int,
+    *,
+    dropout: float = 0.0,
+    seed: int = 0,
+    patience: int = PAPER_PATIENCE,
+    max_epochs: int = PAPER_EPOCHS,
 ) -> tuple[BPConfig, TrainConfig]:
     """The closest variant that converges (see the module docstring).
+
+    Parameters
+    ----------
+    n_inputs : int
+    dropout : float
+        Probability of dropping a hidden unit (PyTorch's convention).
+    seed : int
+    patience : int
+        Epochs without a lower validation loss before training stops (at most
+        ``max_epochs``).
+    max_epochs : int
+        The cap (the paper's 2000).
 
     Raises
     ------
     ValueError
-        If ``epochs`` < 1 or ``dropout`` is outside [0, 1).
+        If ``patience`` or ``max_epochs`` < 1, or ``dropout`` is outside [0, 1).
     """
-    if epochs < 1:
-        raise ValueError(f"epochs = {epochs!r} is out of range: allowed >= 1")
+    for name, value in (("patience", patience), ("max_epochs", max_epochs)):
+        if value < 1:
+            raise ValueError(f"{name} = {value!r} is out of range: allowed >= 1")
     model = BPConfig(n_inputs=n_inputs, hidden=HIDDEN, dropout=dropout, weight_init="uniform")
     train_config = TrainConfig(
-        seed=seed, max_epochs=epochs, patience=epochs, batch_size=16, window_lines=8,
-        learning_rate=1e-2, val_share=0.1, loss="mse", optimiser="sgd", momentum=0.8,
+        seed=seed, max_epochs=max_epochs, patience=min(patience, max_epochs), batch_size=16,
+        window_lines=8, learning_rate=1e-2, val_share=0.1, loss="mse", optimiser="sgd",
+        momentum=0.8,
     )  # fmt: skip
     return model, train_config
 
 
-def finetune_configs(n_inputs: int, *, epochs: int, seed: int = 0) -> tuple[BPConfig, TrainConfig]:
-    """Fine-tuning settings: :func:`variant_configs` without dropout, a tenth of its learning
-    rate (1e-3) and ``epochs`` epochs (the paper gives no fine-tuning settings)."""
-    model, train_config = variant_configs(n_inputs, epochs=epochs, dropout=0.0, seed=seed)
-    return model, replace(train_config, learning_rate=1e-3)
+def finetune_configs(n_inputs: int, *, seed: int = 0) -> tuple[BPConfig, TrainConfig]:
+    """Fine-tuning settings (the paper gives none): :func:`variant_configs` without dropout, at
+    lr 3e-3 (at the variant's 1e-2 the surface-1 network's first steps on a new surface can
+    diverge; at 1e-3 the validation loss creeps down for thousands of epochs), capped at
+    :data:`FINETUNE_EPOCHS`."""
+    model, train_config = variant_configs(
+        n_inputs, dropout=0.0, seed=seed, max_epochs=FINETUNE_EPOCHS
+    )
+    return model, replace(train_config, learning_rate=3e-3)
 
 
 def train(
@@ -281,8 +324,8 @@ def dropout_sweep(
 BATCH_RUNS = tuple((b, p) for b in (1, 32, 256, None) for p in (0.5, 0.0))
 
 
-def _batch_epochs(batch: int | None, epochs: int) -> int:
-    return {1: 1, None: 2000}.get(batch, epochs)
+def _batch_epochs(batch: int | None) -> int:
+    return {1: 1, None: PAPER_EPOCHS}.get(batch, BATCH_SWEEP_EPOCHS)
 
 
 def batch_sweep(
@@ -290,37 +333,40 @@ def batch_sweep(
     train_rows: np.ndarray,
     test_rows: np.ndarray,
     nets: dict[tuple[int | None, float], Trained | None],
-    *,
-    epochs: int,
 ) -> pd.DataFrame:
     """The paper's settings at batches of 1, 32, 256 rows and the full batch, with dropout
     0.5 and without (:data:`BATCH_RUNS`, trained by :func:`train_networks`).
 
-    Batches of 32 and 256 rows run ``epochs`` epochs; batch 1 runs one epoch (12,474 updates,
-    already more than the full batch's 2000); the full batch runs up to the paper's 2000 epochs
-    (early stopping, :data:`PAPER_PATIENCE`). ``epochs`` and ``updates`` count what ran.
+    Every run stops early after :data:`PAPER_PATIENCE` epochs without improvement. Batch 1
+    runs one epoch (12,474 updates, already more than the full batch's 2000); 32 and 256 rows
+    run up to :data:`BATCH_SWEEP_EPOCHS`; the full batch up to the paper's 2000 epochs.
+    ``epochs`` and ``updates`` count what ran; ``converged`` says whether early stopping ended
+    the run (False: the cap did, and the run was still learning).
 
     Returns
     -------
     pandas.DataFrame
         ``batch_rows`` (0 = full), ``dropout_p``, ``updates``, ``epochs``, ``best_epoch``,
-        ``final_train_mse``, ``test_mse``, ``pred_std_um`` (spread of the predictions; the
-        exact step errors' is ``exact_std_um``), ``share_below_1um_pct``, ``diverged``.
+        ``converged``, ``final_train_mse``, ``test_mse``, ``pred_std_um`` (spread of the
+        predictions; the exact step errors' is ``exact_std_um``), ``share_below_1um_pct``,
+        ``diverged``.
     """
     y = data.exact.error_um[test_rows]
     n_train = len(train_rows) - round(0.1 * len(train_rows))
     rows = []
     for batch, p in BATCH_RUNS:
         net = nets[(batch, p)]
-        n_epochs = _batch_epochs(batch, epochs) if net is None else len(net.history["train"])
+        n_epochs = _batch_epochs(batch) if net is None else len(net.history["train"])
         row = {"batch_rows": batch or 0, "dropout_p": p,
                "updates": n_epochs * (1 if batch is None else -(-n_train // batch)),
-               "epochs": n_epochs, "best_epoch": np.nan, "final_train_mse": np.nan,
+               "epochs": n_epochs, "best_epoch": np.nan, "converged": np.nan,
+               "final_train_mse": np.nan,
                "test_mse": np.nan, "pred_std_um": np.nan, "exact_std_um": float(y.std()),
                "share_below_1um_pct": np.nan, "diverged": True}  # fmt: skip
         if net is not None:
             pred = predict_um(net, data.x[test_rows])
-            row.update(best_epoch=net.best_epoch, final_train_mse=net.history["train"][-1],
+            row.update(best_epoch=net.best_epoch, converged=net.converged,
+                       final_train_mse=net.history["train"][-1],
                        test_mse=scaled_mse(net, data.x[test_rows], y),
                        pred_std_um=float(pred.std()),
                        share_below_1um_pct=transfer_metrics(pred, y)["share_below_1um_pct"],

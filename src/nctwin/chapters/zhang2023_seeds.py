@@ -8,7 +8,11 @@ one another; one torch thread each, so the weights do not depend on the worker o
   the converging variant with dropout 0.5 and without, and the fine-tuning chains of the
   variant without dropout to surfaces 2 and 3 (each seed fine-tunes its own network);
 * the sweeps and diagnostics, once (the chapter's seed): the batch sweep, the dropout sweep
-  (Table 2), the longer fine-tuning and the network trained from scratch on surface 2.
+  (Table 2) and the network trained from scratch on surface 2.
+
+Every network trains until early stopping ends it, under the paper's 2000 epochs as the cap,
+except the batch sweep's runs at 32 and 256 rows
+(:data:`~nctwin.chapters.zhang2023.BATCH_SWEEP_EPOCHS`).
 
 The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and
 are the same for every training seed. The claims judge the **mean of the seeds' predictions**
@@ -66,13 +70,12 @@ class Networks:
         One list per seed: the seed's variant fine-tuned to surface 2 at every share, and its
         15 % surface-2 network fine-tuned to surface 3.
     sweep : dict
-        Dropout probability -> the variant trained ``sweep_epochs`` (None: diverged).
+        Dropout probability -> the variant with that dropout (None: diverged); at 0 and 0.5
+        the first seed's ``variant[0]`` and ``dropout[0]``, the same networks.
     batches : dict
         ``(batch_rows, dropout_p)`` of :data:`~nctwin.chapters.zhang2023.BATCH_RUNS` -> the
         paper's settings at that batch (None: diverged); the full batch at dropout 0.5 is
         ``paper[0]``.
-    longer : Trained
-        The first seed's variant fine-tuned with 15 % of surface 2 for ``longer_epochs``.
     scratch : Trained
         The variant trained from scratch on the same 15 % of surface 2.
     """
@@ -85,7 +88,6 @@ class Networks:
     transfer3: list[list[TransferRun]]
     sweep: dict[float, Trained | None]
     batches: dict[tuple[int | None, float], Trained | None]
-    longer: Trained
     scratch: Trained
 
 
@@ -96,21 +98,16 @@ def _train_or_none(data, rows, model_config, train_config, name) -> Trained | No
         return None
 
 
-def _chain(d1, train_rows, d2, d3, shares, epochs, seed, train_seed, longer_epochs):
-    """The variant without dropout (seed ``train_seed``) and its fine-tuning chains; with
-    ``longer_epochs`` > 0 also the longer fine-tuning to 15 % of surface 2."""
+def _chain(d1, train_rows, d2, d3, shares, seed, train_seed):
+    """The variant without dropout (seed ``train_seed``) and its fine-tuning chains."""
     n = d1.x.shape[1]
-    model_cfg, train_cfg = variant_configs(n, epochs=epochs, dropout=0.0, seed=train_seed)
+    model_cfg, train_cfg = variant_configs(n, dropout=0.0, seed=train_seed)
     name = f"zhang2023_variant_p0_seed{train_seed}"
     net1 = train(d1, train_rows, model_cfg, train_cfg, name=name, progress=False)
-    _, ft = finetune_configs(n, epochs=2 * epochs, seed=train_seed)
+    _, ft = finetune_configs(n, seed=train_seed)
     runs2 = transfer(net1, d2, shares, ft, seed=seed, progress=False)
     runs3 = transfer(runs2[-1].trained, d3, shares, ft, seed=seed, progress=False)
-    longer = None
-    if longer_epochs:
-        _, ft_long = finetune_configs(n, epochs=longer_epochs, seed=train_seed)
-        longer = transfer(net1, d2, (15.0,), ft_long, seed=seed, progress=False)[0].trained
-    return net1, runs2, runs3, longer
+    return net1, runs2, runs3
 
 
 def _call(fn: Callable, args: tuple):
@@ -122,11 +119,8 @@ def train_networks(
     train_rows: np.ndarray,
     seeds: Sequence[int],
     *,
-    epochs: int,
-    sweep_epochs: int,
     probabilities: Sequence[float],
     shares: tuple[float, ...],
-    longer_epochs: int,
     seed: int,
     n_jobs: int = 2,
 ) -> Networks:
@@ -141,9 +135,6 @@ def train_networks(
     seeds : sequence of int
         Training seeds of the networks the claims judge; ``seeds[0]`` also trains the sweeps
         and diagnostics.
-    epochs, sweep_epochs, longer_epochs : int
-        The variant's epochs (fine-tuning: twice as many), the sweeps' and the longer
-        fine-tuning's.
     probabilities : sequence of float
         The dropout sweep's drop probabilities.
     shares : tuple of float
@@ -164,29 +155,29 @@ def train_networks(
     cfgs = paper_configs(n, seed=s0, dropout=0.0)
     tasks["batch", None, 0.0] = task(_train_or_none, d1, train_rows, *cfgs, "zhang2023_batch0_p0")
     for s in seeds:
-        tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, epochs, seed, s,
-                                 longer_epochs if s == s0 else 0)  # fmt: skip
+        tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, seed, s)
     for s in seeds:
         cfgs = paper_configs(n, seed=s)
         tasks["paper", s] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_paper_seed{s}")
     for s in seeds:
-        cfgs = variant_configs(n, epochs=epochs, dropout=0.5, seed=s)
+        cfgs = variant_configs(n, dropout=0.5, seed=s)
         tasks["dropout", s] = task(_train_or_none, d1, train_rows, *cfgs,
                                    f"zhang2023_variant_p0.5_seed{s}")  # fmt: skip
     for batch, p in BATCH_RUNS:
         if batch is not None:
             cfgs = paper_configs(n, seed=s0, dropout=p, batch_rows=batch,
-                                 epochs=_batch_epochs(batch, sweep_epochs))  # fmt: skip
+                                 epochs=_batch_epochs(batch))  # fmt: skip
             tasks["batch", batch, p] = task(_train_or_none, d1, train_rows, *cfgs,
                                             f"zhang2023_batch{batch}_p{p:g}")  # fmt: skip
-    for p in probabilities:
-        cfgs = variant_configs(n, epochs=sweep_epochs, dropout=p, seed=s0)
+    for p in (p for p in probabilities if p not in (0.0, 0.5)):  # those: see ``same``
+        cfgs = variant_configs(n, dropout=p, seed=s0)
         tasks["sweep", p] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_sweep_p{p:g}")
     picked2, _ = split(len(d2.x), 0.15, seed=seed)
-    cfgs = variant_configs(n, epochs=2 * epochs, seed=s0)
+    cfgs = variant_configs(n, seed=s0)
     tasks["scratch"] = task(_train_or_none, d2, picked2, *cfgs, "zhang2023_s2_scratch15")
     out = dict(zip(tasks, run_tasks(_call, tasks.values(), n_jobs=n_jobs), strict=True))
     chains = [out["chain", s] for s in seeds]
+    same = {0.0: chains[0][0], 0.5: out["dropout", s0]}  # the sweep's runs trained already
     return Networks(
         seeds=tuple(seeds),
         paper=[out["paper", s] for s in seeds],
@@ -194,12 +185,11 @@ def train_networks(
         variant=[c[0] for c in chains],
         transfer2=[c[1] for c in chains],
         transfer3=[c[2] for c in chains],
-        sweep={p: out["sweep", p] for p in probabilities},
+        sweep={p: same[p] if p in same else out["sweep", p] for p in probabilities},
         batches={
             (b, p): out["paper", s0] if (b, p) == (None, 0.5) else out["batch", b, p]
             for b, p in BATCH_RUNS
         },
-        longer=chains[0][3],
         scratch=out["scratch"],
     )
 
@@ -249,7 +239,7 @@ def seed_runs(
             rows.append({"network": label, "seed": cfg.seed if cfg else -1,
                          "epochs": len(m.history["train"]) if m else np.nan,
                          "best_epoch": m.best_epoch if m else np.nan,
-                         "converged": m.best_epoch < cfg.max_epochs - cfg.patience if m else np.nan,
+                         "converged": m.converged if m else np.nan,
                          "test_mse": float(np.mean(((pred - y_um) / y_std_um) ** 2)),
                          **transfer_metrics(pred, y_um)})  # fmt: skip
     return pd.DataFrame(rows)
