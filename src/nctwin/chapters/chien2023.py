@@ -36,7 +36,7 @@ at samples labelled with the two blocks that meet) misses the junctions of G-lin
 :math:`F/K_v` and moves time between neighbouring short G-lines (:func:`recording_effects`
 measures it).
 
-Every network is trained once per seed (:func:`fit_seeds`, in parallel through
+Every network is trained once per seed (:func:`nctwin.learn.seeds.fit_seeds`, in parallel through
 :func:`nctwin.runner.run_tasks`) and a table's prediction is the ensemble mean
 (:func:`predict_run`). Simulations of a list of programs run through the same runner (one task
 per program) and are cached in ``data/cache/chien2023/`` under a hash of the programs' text,
@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 
 import numpy as np
 import pandas as pd
@@ -58,7 +58,8 @@ from ..estimate import cam
 from ..estimate.kernel import fir_settings
 from ..kernel import fir
 from ..learn.models import ModelConfig
-from ..learn.train import TrainConfig, Trained, fit
+from ..learn.seeds import fit_seeds
+from ..learn.train import TrainConfig, Trained
 from ..machine import MachineProfile
 from ..methods import chien2023 as chien
 from ..motion import Motion
@@ -134,42 +135,6 @@ def train_config(seed: int = 0, scale: float = 1.0) -> TrainConfig:
     """
     epochs = max(5, round(MAX_EPOCHS * scale))
     return TrainConfig(seed=seed, max_epochs=epochs, patience=PATIENCE, log_inputs=(1,))
-
-
-def _fit(model_config: ModelConfig, cfg: TrainConfig, xs, ys, name: str) -> Trained:
-    return fit(model_config, cfg, xs, ys, name=name, progress=False)
-
-
-def fit_seeds(
-    jobs: dict[str, tuple[ModelConfig, TrainConfig, Sequence[np.ndarray], Sequence[np.ndarray]]],
-    seeds: Sequence[int],
-    *,
-    n_jobs: int = 2,
-) -> dict[str, list[Trained]]:
-    """Train every network of ``jobs`` once per seed, all in parallel through
-    :func:`nctwin.runner.run_tasks` (each run cached by :func:`nctwin.learn.train.fit` as
-    ``<name>_seed<s>``).
-
-    Parameters
-    ----------
-    jobs : dict
-        ``name -> (model_config, train_config, xs, ys)``; the seed of ``train_config`` is
-        replaced by each of ``seeds``. List the slowest first: the runner hands out tasks in
-        order.
-    seeds : sequence of int
-    n_jobs : int
-        Parallel trainings (each on one thread).
-
-    Returns
-    -------
-    dict
-        ``name -> [Trained per seed]``, in the order of ``seeds``.
-    """
-    tasks = [(name, cfg_m, replace(cfg, seed=s), xs, ys)
-             for name, (cfg_m, cfg, xs, ys) in jobs.items() for s in seeds]  # fmt: skip
-    out = run_tasks(_fit, ((m, c, x, y, f"{n}_seed{c.seed}") for n, m, c, x, y in tasks),
-                    n_jobs=n_jobs, desc="networks")  # fmt: skip
-    return {name: out[i * len(seeds) : (i + 1) * len(seeds)] for i, name in enumerate(jobs)}
 
 
 def convergence(models: dict[str, Sequence[Trained]]) -> pd.DataFrame:

@@ -22,12 +22,12 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from ..learn.seeds import fit_seeds
 from ..learn.train import TrainConfig, Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
 from ..report.claims import claims_by_seed
 from ..report.tables import Claim, side_by_side
-from .chien2023 import fit_seeds
 from .denkena2020_bench import (
     DIRECTIONS,
     TOOL,
@@ -292,7 +292,7 @@ def train_lstms(
     n_jobs: int = 2,
 ) -> tuple[dict[int, dict[str, Trained]], fm.InputScaling]:
     """One network per force component and seed on the training processes, all of them in
-    parallel (:func:`nctwin.chapters.chien2023.fit_seeds`: one task per network and seed through
+    parallel (:func:`nctwin.learn.seeds.fit_seeds`: one task per network and seed through
     :func:`nctwin.runner.run_tasks`, one torch thread each, so the same bits as one after the
     other; each cached by :func:`nctwin.learn.train.fit` as ``denkena2020_<axis>_seed<s>``).
 
