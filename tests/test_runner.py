@@ -30,8 +30,10 @@ def test_a_dask_cluster_gives_the_local_bits(monkeypatch):
     # the chapter's simulations, as a sweep would send them: two programs on the FIR kernel
     distributed = pytest.importorskip("dask.distributed")
     machine = load_machine("paper1_sim")
-    tasks = [(mixed_program(3, n_lines=60, feed_mm_s=80.0, tol_mm=0.3), machine, None, 0),
-             (global_program(4, n_lines=60, feed_mm_s=70.0, tol_mm=0.4), machine, None, 1)]
+    tasks = [
+        (mixed_program(3, n_lines=60, feed_mm_s=80.0, tol_mm=0.3), machine, None, 0),
+        (global_program(4, n_lines=60, feed_mm_s=70.0, tol_mm=0.4), machine, None, 1),
+    ]
     monkeypatch.delenv(SCHEDULER_ENV, raising=False)
     local = run_tasks(ch.simulate_one, tasks, n_jobs=2)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None,

@@ -281,9 +281,7 @@ def program_units(text: str, default: str = "mm") -> str:
     return "inch" if match.group(1) == "0" else "mm"
 
 
-def _load(
-    args: argparse.Namespace, stage: _Stages
-) -> tuple[MachineProfile, Toolpath, str, str]:
+def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Toolpath, str, str]:
     """The machine, the parsed program, its text and the reader that read it (``native`` or
     ``linuxcnc``; subroutine files are looked up beside the program).
 

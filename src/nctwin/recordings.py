@@ -197,4 +197,3 @@ def load_recordings(folder: Path | None = None) -> dict[str, RecordedProgram]:
     if not paths:
         raise ValueError(f"{folder} holds no recording: run `make record` (needs LinuxCNC)")
     return {p.stem: RecordedProgram.load(p) for p in paths}
-

@@ -235,8 +235,6 @@ def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) ->
     ).reset_index()
 
 
-
-
 # ------------------------------------------------------------------------------------------------
 # The chapter's inputs and claims
 
@@ -373,8 +371,7 @@ def claims(
               planner.worst_abs_err_pct.iloc[0] if len(planner) else float("nan"), "<=", 8.0),
     ]  # fmt: skip
     first = planner_rules_summary[
-        (planner_rules_summary.set == "cam")
-        & (planner_rules_summary.rules == "as first written")
+        (planner_rules_summary.set == "cam") & (planner_rules_summary.rules == "as first written")
     ]
     claims += [
         Claim("planner_worst_own", "the blend-arc planner: worst cycle-time error <= 8 % on the "

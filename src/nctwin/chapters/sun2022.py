@@ -338,8 +338,10 @@ def predict_all_feeds(members: list[list[Trained]], runs: list[PocketRun]) -> li
     """:func:`predict_feeds` of several pockets, each network run once over all of them."""
     x = np.concatenate([r.features for r in runs])
     feeds = np.mean(
-        [np.column_stack([m.predict(x[:, a])[:, 0] for a, m in enumerate(models)])
-         for models in members],
+        [
+            np.column_stack([m.predict(x[:, a])[:, 0] for a, m in enumerate(models)])
+            for models in members
+        ],
         axis=0,
     )
     return np.split(feeds, np.cumsum([len(r.features) for r in runs])[:-1])

@@ -95,9 +95,7 @@ class FirSettings:
             raise ValueError(f"blend_ratio = {r!r} is out of range: allowed (0, 1] or inf")
         n = self.block_periods
         if not (isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 100):
-            raise ValueError(
-                f"block_periods = {n!r} is out of range: allowed integers in [0, 100]"
-            )
+            raise ValueError(f"block_periods = {n!r} is out of range: allowed integers in [0, 100]")
 
     @classmethod
     def load(cls, machine: str | Path | None = None) -> FirSettings:
