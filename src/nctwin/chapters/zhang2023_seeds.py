@@ -10,8 +10,9 @@ one another; one torch thread each, so the weights do not depend on the worker o
 * the sweeps and diagnostics, once (the chapter's seed): the batch sweep, the dropout sweep
   (Table 2) and the network trained from scratch on surface 2.
 
-Every network trains until early stopping ends it, under the paper's 2000 epochs as the cap,
-except the batch sweep's runs at 32 and 256 rows
+Every network trains until early stopping ends it, under a cap that it does not reach (the
+paper's 2000 epochs on surface 1, :data:`~nctwin.chapters.zhang2023.FINETUNE_EPOCHS` for
+fine-tuning), except the batch sweep's runs at 32 and 256 rows, which have a budget
 (:data:`~nctwin.chapters.zhang2023.BATCH_SWEEP_EPOCHS`).
 
 The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and

@@ -1,10 +1,10 @@
 r"""One training step of the BP network (:class:`~nctwin.learn.models.BPNetwork`) with SGD and
-momentum, written out: the arithmetic of autograd and :class:`torch.optim.SGD`, in a third of
-the time.
+momentum, written out: the arithmetic of autograd and :class:`torch.optim.SGD`, in less than
+half the time (``benchmarks/bp_training.py``: 0.22 against 0.47 ms for 128 rows).
 
 The BP network of Zhang et al. (2023) is so small (325 x 28 x 20 x 1) that the bookkeeping of
-autograd, of the modules and of the optimiser, not the arithmetic, takes most of a step (about
-0.8 ms for 128 rows on one core). :class:`BPStep` runs the same step in a few tensor operations:
+autograd, of the modules and of the optimiser, not the arithmetic, takes most of a step.
+:class:`BPStep` runs the same step in a few tensor operations:
 
 * forward: :math:`a_k = h_{k-1} W_k^T + b_k`, :math:`h_k = \max(a_k, 0) \odot r_k / (1 - p)`
   for the hidden layers, with dropout masks :math:`r_k \sim \text{Bernoulli}(1 - p)` (eq. 13;

@@ -29,8 +29,8 @@ Determinism
     the same weights, bit for bit, on one machine.
 Steps
     A step is autograd and a :mod:`torch.optim` optimiser, except for the BP network with SGD,
-    whose step is written out (:class:`~nctwin.learn.bp_sgd.BPStep`, the same arithmetic in a
-    third of the time).
+    whose step is written out (:class:`~nctwin.learn.bp_sgd.BPStep`, the same arithmetic in
+    less than half the time).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
