@@ -328,6 +328,11 @@ def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) ->
     return mse.sqrt() if kind == "rmse" else mse
 
 
+def _written_out(model_config: ModelConfig | BPConfig, cfg: TrainConfig) -> bool:
+    """Whether the step is :class:`~nctwin.learn.bp_sgd.BPStep` (the BP network with SGD)."""
+    return isinstance(model_config, BPConfig) and cfg.optimiser == "sgd"
+
+
 def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
     """One optimiser step on a batch by autograd; the batch's loss, before the step."""
     loss = _loss(model(x), y, mask, kind)
@@ -387,7 +392,7 @@ def fit(
            "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
-    if isinstance(model_config, BPConfig) and train_config.optimiser == "sgd":
+    if _written_out(model_config, train_config):
         key["step"] = "BPStep"  # written out, not autograd: other bits than before it existed
     path = cache_path("models", name, content_key(key), ".pt")
     if cache and path.exists():
@@ -436,7 +441,7 @@ def _train(
         model = build(model_config, generator=generator)
     if init is not None:
         model.load_state_dict(init.model.state_dict())
-    if isinstance(model, BPNetwork) and cfg.optimiser == "sgd":
+    if _written_out(model_config, cfg):
         step = BPStep(model, cfg.learning_rate, cfg.momentum, cfg.loss)
     else:
         if cfg.optimiser == "sgd":
