@@ -22,20 +22,22 @@ Windows
 Determinism
     The initial weights, the window offsets and the batch order are drawn from generators seeded
     with ``seed``, and so are dropout masks (torch's global generator, seeded with ``seed``
-    inside :func:`torch.random.fork_rng`, so the caller's random state is untouched); :func:`fit`
-    runs with ``torch.use_deterministic_algorithms(True)`` and one
-    intra-op thread (``torch.set_num_threads(1)``: summation order, hence rounding, depends on the
-    thread count), and restores both settings when it returns. The same data and configs give
-    the same weights, bit for bit, on one machine.
+    inside :func:`torch.random.fork_rng`, so the caller's random state is untouched; the BP
+    network's written-out epoch draws from its own generator); :func:`fit` runs with
+    ``torch.use_deterministic_algorithms(True)``, one torch intra-op thread
+    (``torch.set_num_threads(1)``) and one BLAS thread (:func:`threadpoolctl.threadpool_limits`):
+    summation order, hence rounding, depends on the thread count. It restores all three when it
+    returns. The same data and configs give the same weights, bit for bit, on one machine.
 Steps
     A step is autograd and a :mod:`torch.optim` optimiser, except for the BP network with SGD,
-    whose step is written out (:class:`~nctwin.learn.bp_sgd.BPStep`, the same arithmetic in
-    less than half the time).
+    whose epoch is written out and compiled (:class:`~nctwin.learn.bp_sgd.BPEpoch`: the same
+    arithmetic, batch for batch, with the torch and Python bookkeeping of every step gone).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
     ``AVX512`` on such a CPU outside it: their rounding differs, so a network trained outside
-    ``make`` is never reused by a chapter run through it), written atomically (temporary file,
+    ``make`` is never reused by a chapter run through it; the written-out epoch adds OpenBLAS's
+    kernels, :func:`~nctwin.learn.bp_sgd.blas_kernels`), written atomically (temporary file,
     then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
     tensors and plain Python values only, never pickled objects.
 """
@@ -49,15 +51,15 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 import torch
+from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from ..cache import atomic_write, cache_path, content_key
-from .bp_sgd import BPStep
+from .bp_sgd import BPEpoch, blas_kernels
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
@@ -278,9 +280,12 @@ def _split(n_programs: int, cfg: TrainConfig) -> tuple[np.ndarray, np.ndarray]:
     return np.sort(order[n_val:]), np.sort(order[:n_val])
 
 
-def _windows(lengths: Sequence[int], w: int, rng: np.random.Generator | None):
-    """(program, start, valid) of windows covering every program; a random offset per program
-    (none when ``rng`` is None). Programs shorter than ``w`` give one window, padded."""
+def _windows(lengths: Sequence[int], w: int, rng: np.random.Generator | None) -> np.ndarray:
+    """(program, start, valid) of windows covering every program, shape (B, 3); a random offset
+    per program (none when ``rng`` is None). Programs shorter than ``w`` give one window,
+    padded, and draw no offset."""
+    if max(lengths) <= w:  # one window each (the BP network's chunks): no loop
+        return np.stack([np.arange(len(lengths)), np.zeros(len(lengths), int), lengths], axis=1)
     out = []
     for p, n in enumerate(lengths):
         if n <= w:
@@ -293,7 +298,7 @@ def _windows(lengths: Sequence[int], w: int, rng: np.random.Generator | None):
         if starts[-1] + w < n:
             starts = np.append(starts, n - w)
         out += [(p, int(s), w) for s in starts]
-    return out
+    return np.array(out)
 
 
 class _Programs:
@@ -308,7 +313,8 @@ class _Programs:
     def __init__(self, zx: Sequence[np.ndarray], zy: Sequence[np.ndarray]) -> None:
         self.x = np.concatenate(zx).astype(np.float32)
         self.y = np.concatenate(zy).astype(np.float32)
-        self.start = np.cumsum([0, *(len(x) for x in zx)])[:-1]
+        self.lengths = [len(x) for x in zx]
+        self.start = np.cumsum([0, *self.lengths])[:-1]
 
     def batch(self, windows: np.ndarray, w: int):
         """Stack ``windows`` (B, 3) of (program, start, valid) into (B, w, n) inputs, targets
@@ -322,6 +328,17 @@ class _Programs:
         y[~m] = 0.0
         return torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(m)
 
+    def epoch_rows(self, windows: np.ndarray, batch_size: int):
+        """The valid rows of ``windows`` (B, 3), in order, cut into batches of ``batch_size``
+        windows: ``rows`` (R,) int64, ``bounds`` (n_batches + 1,) int64 (batch ``b`` is
+        ``rows[bounds[b]:bounds[b + 1]]``) and each batch's window count (float64)."""
+        lengths = windows[:, 2]
+        offsets = np.concatenate([[0], np.cumsum(lengths)])  # row offset of each window
+        first = self.start[windows[:, 0]] + windows[:, 1]
+        rows = np.repeat(first - offsets[:-1], lengths) + np.arange(offsets[-1])
+        edges = np.append(np.arange(0, len(windows), batch_size), len(windows))
+        return rows.astype(np.int64), offsets[edges].astype(np.int64), np.diff(edges) * 1.0
+
 
 def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) -> torch.Tensor:
     mse = ((pred - y) ** 2 * mask).sum() / mask.sum().clamp(min=1)
@@ -329,7 +346,7 @@ def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) ->
 
 
 def _written_out(model_config: ModelConfig | BPConfig, cfg: TrainConfig) -> bool:
-    """Whether the step is :class:`~nctwin.learn.bp_sgd.BPStep` (the BP network with SGD)."""
+    """Whether the epoch is :class:`~nctwin.learn.bp_sgd.BPEpoch` (the BP network with SGD)."""
     return isinstance(model_config, BPConfig) and cfg.optimiser == "sgd"
 
 
@@ -340,6 +357,67 @@ def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
     loss.backward()
     optimiser.step()
     return loss.detach()
+
+
+class _AutogradRun:
+    """Epochs by autograd and a :mod:`torch.optim` optimiser, validation by the torch model."""
+
+    def __init__(self, model, cfg: TrainConfig, programs: _Programs, validation: _Programs):
+        self.model, self.cfg, self.programs = model, cfg, programs
+        w = cfg.window_lines
+        self.validation = validation.batch(_windows(validation.lengths, w, None), w)
+        if cfg.optimiser == "sgd":
+            self.optimiser = torch.optim.SGD(
+                model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
+            )
+        else:
+            self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+
+    def epoch(self, windows: np.ndarray) -> float:
+        """Steps on ``windows`` in batches of ``batch_size``; the mean of the batch losses,
+        weighted by their windows."""
+        self.model.train()
+        total, count, cfg = 0.0, 0, self.cfg
+        for b in range(0, len(windows), cfg.batch_size):
+            bx, by, bm = self.programs.batch(windows[b : b + cfg.batch_size], cfg.window_lines)
+            loss = _autograd_step(self.model, self.optimiser, cfg.loss, bx, by, bm)
+            total += float(loss) * len(bx)
+            count += len(bx)
+        self.model.eval()
+        return total / count
+
+    def validate(self) -> float:
+        with torch.no_grad():
+            x, y, mask = self.validation
+            return float(_loss(self.model(x), y, mask, self.cfg.loss))
+
+    def state(self):
+        return copy.deepcopy(self.model.state_dict())
+
+    def load(self, state) -> None:
+        self.model.load_state_dict(state)
+
+
+class _WrittenOutRun:
+    """The epochs and validation of :class:`~nctwin.learn.bp_sgd.BPEpoch`, batch for batch
+    those of :class:`_AutogradRun` (a batch: the valid rows of ``batch_size`` windows)."""
+
+    def __init__(self, model, cfg: TrainConfig, programs: _Programs, validation: _Programs):
+        self.cfg, self.programs, self.validation = cfg, programs, validation
+        self.bp = BPEpoch(model, cfg.learning_rate, cfg.momentum, cfg.loss, seed=cfg.seed)
+
+    def epoch(self, windows: np.ndarray) -> float:
+        rows = self.programs.epoch_rows(windows, self.cfg.batch_size)
+        return self.bp(self.programs.x, self.programs.y, *rows)
+
+    def validate(self) -> float:
+        return self.bp.loss(self.validation.x, self.validation.y)
+
+    def state(self) -> np.ndarray:
+        return self.bp.weights.copy()
+
+    def load(self, state: np.ndarray) -> None:
+        self.bp.load(state)
 
 
 def fit(
@@ -392,8 +470,8 @@ def fit(
            "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
-    if _written_out(model_config, train_config):
-        key["step"] = "BPStep"  # written out, not autograd: other bits than before it existed
+    if _written_out(model_config, train_config):  # written out, not autograd: other bits
+        key["step"], key["blas"] = "BPEpoch", blas_kernels()
     path = cache_path("models", name, content_key(key), ".pt")
     if cache and path.exists():
         return load_checkpoint(path)
@@ -411,7 +489,7 @@ def fit(
         # training repeats bit for bit and the caller's random state is left as it was
         with torch.random.fork_rng(devices=[]):
             torch.manual_seed(train_config.seed)
-            with one_thread():
+            with one_thread(), threadpool_limits(1, user_api="blas"):  # BLAS: see bp_sgd
                 trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     finally:
         torch.use_deterministic_algorithms(deterministic)
@@ -441,20 +519,10 @@ def _train(
         model = build(model_config, generator=generator)
     if init is not None:
         model.load_state_dict(init.model.state_dict())
-    if _written_out(model_config, cfg):
-        step = BPStep(model, cfg.learning_rate, cfg.momentum, cfg.loss)
-    else:
-        if cfg.optimiser == "sgd":
-            optimiser = torch.optim.SGD(
-                model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
-            )
-        else:
-            optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
-        step = partial(_autograd_step, model, optimiser, cfg.loss)
-    val_programs = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
-    vx, vy, vm = val_programs.batch(np.array(_windows([len(zx[i]) for i in val_idx], w, None)), w)
-    tx = [zx[i] for i in train_idx]
-    programs = _Programs(tx, [zy[i] for i in train_idx])
+    programs = _Programs([zx[i] for i in train_idx], [zy[i] for i in train_idx])
+    validation = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
+    run_class = _WrittenOutRun if _written_out(model_config, cfg) else _AutogradRun
+    run = run_class(model, cfg, programs, validation)
     history: dict[str, list[float]] = {"train": [], "val": []}
     best, best_state, best_epoch, stale = math.inf, None, 0, 0
     # shown after 5 s only, so that short runs leave no text in executed notebooks; ``disable``
@@ -468,22 +536,15 @@ def _train(
         **({} if progress else {"disable": True}),
     )
     for epoch in bar:
-        model.train()
-        windows = np.array(_windows([len(x) for x in tx], w, rng))
-        windows = windows[rng.permutation(len(windows))]
-        total, count = 0.0, 0
-        for b in range(0, len(windows), cfg.batch_size):
-            bx, by, bm = programs.batch(windows[b : b + cfg.batch_size], w)
-            total += float(step(bx, by, bm)) * len(bx)
-            count += len(bx)
-        model.eval()
-        with torch.no_grad():
-            val = float(_loss(model(vx), vy, vm, cfg.loss))
-        history["train"].append(total / count)
+        windows = _windows(programs.lengths, w, rng)
+        train_loss = run.epoch(windows[rng.permutation(len(windows))])
+        val = run.validate()
+        history["train"].append(train_loss)
         history["val"].append(val)
-        bar.set_postfix(train=f"{total / count:.4f}", val=f"{val:.4f}", refresh=False)
+        if not bar.disable:  # formatting costs 40 us, as much as a small epoch's step
+            bar.set_postfix(train=f"{train_loss:.4f}", val=f"{val:.4f}", refresh=False)
         if val < best:
-            best, best_state, best_epoch, stale = val, copy.deepcopy(model.state_dict()), epoch, 0
+            best, best_state, best_epoch, stale = val, run.state(), epoch, 0
         else:
             stale += 1
             if stale >= cfg.patience:
@@ -494,7 +555,7 @@ def _train(
             f"{path.stem}: the validation loss was never finite (the training diverged); "
             f"learning_rate = {cfg.learning_rate!r} may be too large"
         )
-    model.load_state_dict(best_state)
+    run.load(best_state)
     model.eval()
     return Trained(
         model, x_scaler, y_scaler, cfg, history, best_epoch, time.perf_counter() - t0, path
