@@ -106,3 +106,30 @@ def test_load_puts_the_weights_into_the_model() -> None:
 def test_blas_kernels_names_the_openblas_kernels() -> None:
     name = blas_kernels()
     assert name and name != "none"
+
+
+@pytest.mark.parametrize(
+    ("rows", "bounds", "batch_weights", "match"),
+    [
+        ([0, 9], [0, 2], [1.0], "rows"),
+        ([0, -1], [0, 2], [1.0], "rows"),
+        ([0, 1], [0, 1], [1.0], "bounds"),
+        ([0, 1], [0, 0, 2], [1.0, 1.0], "strictly increasing"),
+        ([0, 1], [0, 2], [1.0, 1.0], "batch_weights"),
+    ],
+)
+def test_bad_batches_are_refused_with_the_allowed_range(rows, bounds, batch_weights, match):
+    config = BPConfig(n_inputs=3, hidden=(2,), dropout=0.0, weight_init="uniform")
+    epoch = BPEpoch(build_bp(config), 0.1, 0.8, "mse", seed=0)
+    x, y = np.zeros((4, 3), np.float32), np.zeros((4, 1), np.float32)
+    with pytest.raises(ValueError, match=match):
+        epoch(x, y, np.array(rows), np.array(bounds), np.array(batch_weights))
+
+
+def test_samples_of_the_wrong_width_are_refused() -> None:
+    config = BPConfig(n_inputs=3, hidden=(2,), dropout=0.0, weight_init="uniform")
+    epoch = BPEpoch(build_bp(config), 0.1, 0.8, "mse", seed=0)
+    with pytest.raises(ValueError, match=r"x has shape \(4, 2\): allowed \(N, 3\)"):
+        epoch.loss(np.zeros((4, 2)), np.zeros((4, 1)))
+    with pytest.raises(ValueError, match="y has shape"):
+        epoch.loss(np.zeros((4, 3)), np.zeros((3, 1)))

@@ -116,6 +116,28 @@ def test_batch_of_windows_is_the_windows_stacked_by_hand(lengths, w, seed):
         assert not x[i, v:].any() and not y[i, v:].any() and not m[i, v:].any()
 
 
+@settings(max_examples=40, deadline=None)
+@given(
+    lengths=st.lists(st.integers(1, 30), min_size=1, max_size=6),
+    w=st.integers(1, 12),
+    batch_size=st.integers(1, 5),
+    seed=st.integers(0, 2**16),
+)
+def test_epoch_rows_are_the_valid_rows_of_the_batches(lengths, w, batch_size, seed):
+    rng = np.random.default_rng(seed)
+    xs = [rng.normal(size=(n, 3)) for n in lengths]
+    programs = _Programs(xs, [x[:, :1] for x in xs])
+    windows = _windows(lengths, w, rng)
+    windows = windows[rng.permutation(len(windows))]
+    rows, bounds, counts = programs.epoch_rows(windows, batch_size)
+    assert bounds[0] == 0 and bounds[-1] == len(rows) and np.all(np.diff(bounds) > 0)
+    for b in range(len(bounds) - 1):  # by hand: batch b's windows, their valid rows in order
+        chunk = windows[b * batch_size : (b + 1) * batch_size]
+        assert counts[b] == len(chunk)
+        x, _, m = programs.batch(chunk, w)
+        np.testing.assert_array_equal(programs.x[rows[bounds[b] : bounds[b + 1]]], x[m[..., 0]])
+
+
 def test_checkpoint_round_trip_and_cache_hit():
     xs, ys = _data()
     a = fit(ModelConfig(n_inputs=2, hidden=4), CFG, xs, ys, name="t", progress=False)

