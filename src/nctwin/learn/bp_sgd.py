@@ -93,8 +93,7 @@ class BPEpoch:
     def _workspace(self, name: str, n_rows: int, n_inputs: int) -> np.ndarray:
         """Scratch memory for batches of ``n_rows``, kept between calls: fresh memory each
         epoch costs page faults (a full-batch epoch took 25 ms against 16 ms)."""
-        size = n_rows * (n_inputs + int(self.shapes[-1, 0]))
-        size += n_rows * int(2 * self.shapes[:, 0].sum() + self.shapes[:, 1].sum())
+        size = int(_buffer_sizes(n_rows, n_inputs, self.shapes).sum())
         if self.workspaces.get(name, np.empty(0)).size < size:
             self.workspaces[name] = np.empty(size, np.float32)
         return self.workspaces[name]
@@ -184,15 +183,24 @@ def _starts(shapes):
 
 
 @njit(cache=True)
-def _buffers(workspace, n, n_inputs, shapes):
-    """Views of ``workspace`` for batches of up to ``n`` rows: the batch's inputs (n, n_inputs)
-    and targets (n, n_outputs), and per layer k its outputs and factors (n, out_k) and the
-    gradient with respect to its inputs (n, in_k) (:meth:`BPEpoch._workspace` sizes it)."""
+def _buffer_sizes(n, n_inputs, shapes):
+    """Sizes of the views :func:`_buffers` cuts, in order: one layout for both."""
     layers = range(shapes.shape[0])
     sizes = [n * n_inputs, n * shapes[-1, 0]]
     sizes += [n * shapes[k, 0] for k in layers] + [n * shapes[k, 0] for k in layers]
     sizes += [n * shapes[k, 1] for k in layers]
-    ends = np.cumsum(np.array(sizes))
+    return np.array(sizes)
+
+
+@njit(cache=True)
+def _buffers(workspace, n, n_inputs, shapes):
+    """Views of ``workspace`` for batches of up to ``n`` rows: the batch's inputs (n, n_inputs)
+    and targets (n, n_outputs), and per layer k its outputs and factors (n, out_k) and the
+    gradient with respect to its inputs (n, in_k); :meth:`BPEpoch._workspace` allocates the sum
+    of :func:`_buffer_sizes`."""
+    layers = range(shapes.shape[0])
+    sizes = _buffer_sizes(n, n_inputs, shapes)
+    ends = np.cumsum(sizes)
     views = [workspace[ends[i] - sizes[i] : ends[i]] for i in range(len(sizes))]
     n_layers = shapes.shape[0]
     x_rows = views[0].reshape((n, n_inputs))
