@@ -14,7 +14,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "nctwin"
 LAYERS = (
     ("_rows", "paths", "checks", "runner", "_geometry_loops"),
     ("toolpath", "cache"),
-    ("motion", "geometry", "machine"),
+    ("motion", "geometry", "controls", "machine", "limits"),
     ("gcode", "naivecam", "targets"),
     ("report",),
     ("physics",),

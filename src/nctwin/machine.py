@@ -1,13 +1,25 @@
-"""Machine profiles: what a machine tool and its control are, loaded from ``data/machines/*.toml``.
+"""Machine profiles: what a machine tool physically is, how its controls move it, and which
+estimate to trust, in one file (``data/machines/*.toml``).
 
-A :class:`MachineProfile` holds what a control's machine data hold: axis limits, rapid and maximum
-feed, interpolation period, default blending tolerance, the time constants of its acc/dec filters
-and its servo loops. Every value is checked on construction; a bad one raises :class:`ValueError`
-naming the field, the value and the allowed range.
+A profile's file has one ``[machine]`` table (:class:`Machine`: axis limits, rapid and maximum
+feed), one ``[control.<kind>]`` table per control model it is described for
+(:data:`nctwin.controls.CONTROLS`: ``fir``, ``accdec``, ``fanuc``, ``planner``), and two
+top-level keys: ``default_method``, the method ``nctwin estimate`` uses when none is named, and
+``recordings``, the shipped recordings of this machine the learned methods train on (if any).
+No key is written twice, and an unknown or misspelt key is refused with the file, the table and
+the key. Values fitted to recordings are written into the file by a command
+(:func:`write_control`), never looked up elsewhere at run time, so a copy of a profile under
+another name is the same machine.
 
-How a virtual kernel interpolates the machine is not part of it: a profile's file may hold a
-kernel's settings in a table of their own (``[fir]`` for :class:`nctwin.kernel.fir.FirSettings`),
-read by :func:`load_table`.
+::
+
+    default_method = "cam"
+    [machine]
+    name = "generic_mill"
+    axis_max_velocity_mm_s = [500.0, 500.0, 500.0]
+    ...
+    [control.fir]
+    t1_s = 0.06
 """
 
 from __future__ import annotations
@@ -15,70 +27,71 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import MISSING, dataclass, fields
+from datetime import date
 from pathlib import Path
 
+from .checks import check_number, check_xyz
+from .controls import (
+    CONTROLS,
+    AccDecControl,
+    Control,
+    FanucControl,
+    FirControl,
+    PlannerControl,
+)
 from .paths import data_dir
 
 __all__ = [
     "DEFAULT_MACHINE",
-    "MachineProfile",
+    "METHOD_CONTROLS",
+    "Machine",
+    "Profile",
     "available_machines",
     "load_machine",
-    "load_table",
+    "load_profile",
     "profile_path",
-    "whole_periods",
+    "write_control",
 ]
 
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
-#: Tables of a profile's file that hold a kernel's settings (see :func:`load_table`).
-KERNEL_TABLES = ("fir", "fanuc")
+
+#: The control model each estimate method runs on (None: the machine alone).
+METHOD_CONTROLS: dict[str, str | None] = {
+    "cam": None,
+    "kernel": "fir",
+    "block_overlap": "accdec",
+    "planner": "planner",
+    "bilstm": "planner",
+    "axis_nn": "planner",
+}
 
 _XYZ = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
-class MachineProfile:
-    """Settings of a 3-axis machine tool and its control.
+class Machine:
+    """What a 3-axis machine tool physically is: its limits, apart from any control.
 
     Parameters
     ----------
     name : str
-        Short name (the TOML file's stem).
+        Short name (a shipped profile's name; the file's stem where the file gives none).
     description : str
         What the profile stands for.
     axis_max_velocity_mm_s : tuple of 3 floats
-        Velocity limit of X, Y, Z.
+        Velocity limit of X, Y, Z, each > 0.
     axis_max_acceleration_mm_s2 : tuple of 3 floats
-        Acceleration limit of X, Y, Z.
+        Acceleration limit of X, Y, Z, each > 0. The FIR kernel, the planner and the learned
+        features keep to it (:func:`nctwin.limits.path_limits`); the acc/dec controls
+        (``accdec``, ``fanuc``) accelerate as their time constants say, which a profile sets
+        within it.
     axis_max_jerk_mm_s3 : tuple of 3 floats
-        Jerk limit of X, Y, Z; ``inf`` for a control without jerk limitation.
+        Jerk limit of X, Y, Z, each > 0; ``inf`` for a machine without one.
     rapid_feed_mm_s : float
-        Path feed of rapid (G0) moves.
+        Path feed of rapid (G0) moves, > 0.
     max_feed_mm_s : float
-        Highest programmable feed; a larger F is clamped to it.
-    period_s : float
-        Interpolation period.
-    blend_tol_mm : float
-        Corner-blending tolerance used where the program sets none (G64 P overrides it).
-    cut_time_constant_s : float
-        Acc/dec time constant of cutting feed (linear type, after interpolation).
-    rapid_time_constant_s : float
-        Acc/dec time constant of rapids.
-    rapid_bell_s : float
-        Bell-shaped (S-curve) stage added to rapids; 0 for none.
-    rapid_type : {"linear", "nonlinear"}
-        Path of rapids: a straight line at the rapid feed (linear interpolation type), or each
-        axis on its own at the rapid feed (non-linear type, Lee et al. 2022, Fig. 3).
-    position_gain_per_s : tuple of 3 floats
-        Position-loop gain Kp of X, Y, Z (first-order loop: following error decays as
-        ``exp(-Kp t)``).
-    inposition_width_mm : tuple of 3 floats
-        In-position width of X, Y, Z: after a rapid, the next block waits until every axis's
-        following error is within it.
-    inposition_time_s : tuple of 3 floats
-        Measured in-position time of X, Y, Z after a rapid, used by analytic estimators
-        (Lee et al. 2022, Sec. 2.3); 0 where not measured.
+        Highest programmable feed, > 0; a larger F is clamped to it.
     """
 
     name: str
@@ -88,71 +101,150 @@ class MachineProfile:
     axis_max_jerk_mm_s3: _XYZ
     rapid_feed_mm_s: float
     max_feed_mm_s: float
-    period_s: float = 0.001
-    blend_tol_mm: float = 0.05
-    cut_time_constant_s: float = 0.05
-    rapid_time_constant_s: float = 0.1
-    rapid_bell_s: float = 0.0
-    rapid_type: str = "linear"
-    position_gain_per_s: _XYZ = (30.0, 30.0, 30.0)
-    inposition_width_mm: _XYZ = (0.02, 0.02, 0.02)
-    inposition_time_s: _XYZ = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"name = {self.name!r} must be a non-empty string")
-        for f in (
-            "axis_max_velocity_mm_s",
-            "axis_max_acceleration_mm_s2",
-            "axis_max_jerk_mm_s3",
-            "position_gain_per_s",
-            "inposition_width_mm",
-            "inposition_time_s",
-        ):
-            v = getattr(self, f)
-            try:
-                v = tuple(float(x) for x in v)
-            except (TypeError, ValueError):
-                raise ValueError(f"{f} = {v!r} must be three numbers (X, Y, Z)") from None
-            if len(v) != 3:
-                raise ValueError(f"{f} = {v!r} must be three numbers (X, Y, Z)")
-            allow_inf = f == "axis_max_jerk_mm_s3"
-            lo_closed = f == "inposition_time_s"
-            hi = 10.0 if lo_closed else math.inf
-            for axis, x in zip("XYZ", v, strict=True):
-                _check(f"{f}[{axis}]", x, 0.0, hi, lo_closed=lo_closed, allow_inf=allow_inf)
-            object.__setattr__(self, f, v)
-        _check("rapid_feed_mm_s", self.rapid_feed_mm_s, 0.0, math.inf)
-        _check("max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf)
-        _check("period_s", self.period_s, 0.0, 0.1, hi_closed=True)
-        _check("blend_tol_mm", self.blend_tol_mm, 0.0, 10.0, lo_closed=True, hi_closed=True)
-        for f in ("cut_time_constant_s", "rapid_time_constant_s"):
-            _check(f, getattr(self, f), 0.0, 10.0, lo_closed=True, hi_closed=True)
-        _check("rapid_bell_s", self.rapid_bell_s, 0.0, 10.0, lo_closed=True, hi_closed=True)
-        if self.rapid_type not in ("linear", "nonlinear"):
+            raise ValueError(f"name = {self.name!r} is out of range: allowed a non-empty string")
+        if not isinstance(self.description, str):
+            raise ValueError(f"description = {self.description!r} is out of range: allowed text")
+        for name in ("axis_max_velocity_mm_s", "axis_max_acceleration_mm_s2"):
+            object.__setattr__(self, name, check_xyz(name, getattr(self, name), 0.0, math.inf))
+        jerk = check_xyz("axis_max_jerk_mm_s3", self.axis_max_jerk_mm_s3, 0.0, math.inf,
+                         allow_inf=True)  # fmt: skip
+        object.__setattr__(self, "axis_max_jerk_mm_s3", jerk)
+        check_number("rapid_feed_mm_s", self.rapid_feed_mm_s, 0.0, math.inf)
+        check_number("max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf)
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A machine profile: the machine, its controls, and the profile's default method.
+
+    Parameters
+    ----------
+    machine : Machine
+    fir, accdec, fanuc, planner : control settings or None
+        The control models the profile describes (:data:`nctwin.controls.CONTROLS`); None
+        for a model it does not.
+    default_method : str
+        The method of ``nctwin estimate`` when none is named (a key of
+        :data:`METHOD_CONTROLS` whose control the profile has).
+    recordings : str or None
+        Name of the shipped recordings of this machine (:mod:`nctwin.recordings`) the learned
+        methods train on; None: the learned methods do not exist for it.
+    """
+
+    machine: Machine
+    fir: FirControl | None = None
+    accdec: AccDecControl | None = None
+    fanuc: FanucControl | None = None
+    planner: PlannerControl | None = None
+    default_method: str = "cam"
+    recordings: str | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.machine, Machine):
+            raise ValueError(f"machine = {self.machine!r} is out of range: allowed a Machine")
+        for kind, cls in CONTROLS.items():
+            control = getattr(self, kind)
+            if control is not None and not isinstance(control, cls):
+                raise ValueError(
+                    f"{kind} = {control!r} is out of range: allowed a {cls.__name__} or None"
+                )
+        allowed = [m for m, kind in METHOD_CONTROLS.items() if kind is None or kind in self]
+        if self.default_method not in allowed:
             raise ValueError(
-                f"rapid_type = {self.rapid_type!r} is not allowed: allowed 'linear', 'nonlinear'"
+                f"default_method = {self.default_method!r} is out of range: allowed "
+                f"{', '.join(allowed)} (the methods whose control the profile describes)"
+            )
+        if self.recordings is not None and not (
+            isinstance(self.recordings, str) and self.recordings
+        ):
+            raise ValueError(
+                f"recordings = {self.recordings!r} is out of range: allowed a shipped "
+                "recordings' name"
             )
 
-    @classmethod
-    def from_toml(cls, path: str | Path) -> MachineProfile:
-        """Read a profile from a TOML file (keys as the dataclass fields; ``name`` defaults to
-        the file's stem; the tables of :data:`KERNEL_TABLES` are a kernel's, not the
-        profile's)."""
-        p = Path(path)
-        data = {k: v for k, v in _read_toml(p).items() if k not in KERNEL_TABLES}
-        allowed = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - allowed)
-        if unknown:
+    @property
+    def name(self) -> str:
+        """The machine's name."""
+        return self.machine.name
+
+    @property
+    def controls(self) -> dict[str, Control]:
+        """The control models the profile describes, by kind."""
+        return {k: getattr(self, k) for k in CONTROLS if getattr(self, k) is not None}
+
+    def __contains__(self, kind: str) -> bool:
+        return kind in CONTROLS and getattr(self, kind) is not None
+
+    def control(self, kind: str) -> Control:
+        """The settings of control model ``kind``.
+
+        Raises
+        ------
+        ValueError
+            If the profile describes no such control, naming the table it lacks.
+        """
+        if kind not in CONTROLS:
+            raise ValueError(f"control = {kind!r} is unknown: allowed {', '.join(CONTROLS)}")
+        if kind not in self:
+            have = ", ".join(f"[control.{k}]" for k in self.controls) or "none"
             raise ValueError(
-                f"{p}: unknown field(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}"
+                f"machine profile {self.name} has no [control.{kind}] table (it has {have})"
             )
-        data.setdefault("name", p.stem)
-        missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in data]
-        if missing:
-            raise ValueError(f"{p}: missing field(s) {', '.join(missing)}")
+        return getattr(self, kind)
+
+    def control_for(self, method: str) -> Control | None:
+        """The control the estimate ``method`` runs on (None for ``cam``); ValueError naming
+        the method and the table if the profile lacks it."""
+        if method not in METHOD_CONTROLS:
+            raise ValueError(
+                f"method = {method!r} is unknown: allowed {', '.join(METHOD_CONTROLS)}"
+            )
+        kind = METHOD_CONTROLS[method]
+        if kind is None:
+            return None
         try:
-            return cls(**data)
+            return self.control(kind)
+        except ValueError as err:
+            raise ValueError(f"method {method!r} needs a control: {err}") from None
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Profile:
+        """Read a profile file (see the module docstring).
+
+        Raises
+        ------
+        ValueError
+            One line naming the file, the table and the key, for a file it cannot read, a
+            missing or unknown key or table, or a value out of its range.
+        """
+        p = Path(path)
+        data = _read_toml(p)
+        top = {"machine", "control", "default_method", "recordings"}
+        _refuse_unknown(p, "", data, top)
+        machine_table = data.get("machine")
+        if not isinstance(machine_table, dict):
+            raise ValueError(f"{p}: no [machine] table (the machine's limits)")
+        machine_table = {"name": p.stem, "description": "", **machine_table}
+        machine = _build(p, "[machine]", Machine, machine_table)
+        control_tables = data.get("control", {})
+        if not isinstance(control_tables, dict):
+            raise ValueError(f"{p}: control must be tables ([control.<kind>])")
+        _refuse_unknown(p, "[control]", control_tables, set(CONTROLS))
+        controls = {}
+        for kind, table in control_tables.items():
+            if not isinstance(table, dict):
+                raise ValueError(f"{p}: control.{kind} must be a table ([control.{kind}])")
+            controls[kind] = _build(p, f"[control.{kind}]", CONTROLS[kind], table)
+        try:
+            return cls(
+                machine,
+                **controls,
+                default_method=data.get("default_method", "cam"),
+                recordings=data.get("recordings"),
+            )
         except ValueError as exc:
             raise ValueError(f"{p}: {exc}") from None
 
@@ -167,43 +259,29 @@ def _read_toml(p: Path) -> dict:
         raise ValueError(f"machine profile {p} is not valid TOML: {exc}") from None
 
 
-def _check(
-    name: str,
-    value,
-    lo: float,
-    hi: float,
-    *,
-    lo_closed: bool = False,
-    hi_closed: bool = False,
-    allow_inf: bool = False,
-) -> None:
-    """Raise ValueError unless ``value`` is a number in the given interval."""
-    ok = isinstance(value, int | float) and not isinstance(value, bool) and not math.isnan(value)
-    if ok and not (allow_inf and value == math.inf):
-        ok = (lo <= value if lo_closed else lo < value) and (
-            value <= hi if hi_closed else value < hi
-        )
-    if not ok:
-        interval = f"{'[' if lo_closed else '('}{lo:g}, {hi:g}{']' if hi_closed else ')'}"
-        extra = " or inf" if allow_inf else ""
-        raise ValueError(f"{name} = {value!r} is out of range: allowed {interval}{extra}")
-
-
-def whole_periods(name: str, value_s: float, period_s: float) -> int:
-    """A time setting as a whole number of interpolation periods.
-
-    Raises
-    ------
-    ValueError
-        Naming the setting, its value and the allowed values, if it is not a whole multiple.
-    """
-    k = round(value_s / period_s)
-    if not math.isclose(k * period_s, value_s, rel_tol=1e-9, abs_tol=1e-12):
+def _refuse_unknown(p: Path, table: str, data: dict, allowed: set[str]) -> None:
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        where = f"{table} " if table else ""
         raise ValueError(
-            f"{name} = {value_s!r} is out of range: allowed whole multiples of "
-            f"period_s = {period_s!r}"
+            f"{p}: {where}unknown key(s) {', '.join(unknown)}; allowed: "
+            f"{', '.join(sorted(allowed))}"
         )
-    return k
+
+
+def _build(p: Path, table: str, cls: type, data: dict):
+    """``cls(**data)``, refusing unknown and missing keys and bad values with the file and the
+    table."""
+    names = {f.name for f in fields(cls)}
+    _refuse_unknown(p, table, data, names)
+    missing = [f.name for f in fields(cls) if f.default is MISSING and f.name not in data]
+    if missing:
+        raise ValueError(f"{p}: {table} missing key(s) {', '.join(missing)}")
+    values = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
+    try:
+        return cls(**values)
+    except ValueError as exc:
+        raise ValueError(f"{p}: {table} {exc}") from None
 
 
 def machines_dir() -> Path:
@@ -243,18 +321,80 @@ def profile_path(name: str | Path | None = None) -> Path:
     return shipped
 
 
-def load_machine(name: str | Path | None = None) -> MachineProfile:
+def load_profile(name: str | Path | None = None) -> Profile:
     """Load a shipped profile by name, or a profile file by path (see :func:`profile_path`)."""
-    return MachineProfile.from_toml(profile_path(name))
+    return Profile.from_toml(profile_path(name))
 
 
-def load_table(name: str | Path | None, table: str) -> dict:
-    """A kernel's table of a profile's file (one of :data:`KERNEL_TABLES`); empty if the file
-    has none."""
-    if table not in KERNEL_TABLES:
-        raise ValueError(f"table = {table!r} is unknown: allowed {', '.join(KERNEL_TABLES)}")
-    p = profile_path(name)
-    data = _read_toml(p).get(table, {})
-    if not isinstance(data, dict):
-        raise ValueError(f"{p}: {table} must be a table ([{table}])")
-    return data
+def load_machine(name: str | Path | None = None) -> Machine:
+    """The :class:`Machine` of a profile (see :func:`load_profile`)."""
+    return load_profile(name).machine
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, tuple | list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, float):
+        return "inf" if v == math.inf else repr(v)
+    return repr(v)
+
+
+def write_control(
+    path: str | Path, kind: str, control: Control, provenance: list[str], *, today: date
+) -> None:
+    """Write the ``[control.<kind>]`` table of a profile's file, keeping the rest of it.
+
+    The table's old text (its header, its keys and the comment lines right above it) is
+    replaced by ``provenance`` as comments, then every field of ``control``; where the file has
+    no such table it is appended. The file is written whole, then read back as a profile.
+
+    Parameters
+    ----------
+    path : str or Path
+        The profile's file.
+    kind : str
+        A key of :data:`nctwin.controls.CONTROLS`.
+    control : control settings
+        Of the type ``kind`` names.
+    provenance : list of str
+        What the values were fitted to, how, and the fit's residual: one comment line each.
+    today : date
+        The date written into the provenance.
+    """
+    p = Path(path)
+    if not isinstance(control, CONTROLS.get(kind, ())):
+        raise ValueError(f"control = {control!r} is out of range: allowed a {kind} control")
+    lines = p.read_text().splitlines()
+    header = f"[control.{kind}]"
+    start = next((i for i, line in enumerate(lines) if line.strip() == header), None)
+    if start is None:
+        before, after = lines, []
+    else:
+        stop = next(
+            (i for i in range(start + 1, len(lines)) if lines[i].lstrip().startswith("[")),
+            len(lines),
+        )
+        while stop > start + 1 and (not lines[stop - 1].strip() or lines[stop - 1].startswith("#")):
+            stop -= 1  # the comments above the next table are that table's
+        first = start
+        while first > 0 and lines[first - 1].startswith("#"):
+            first -= 1
+        before, after = lines[:first], lines[stop:]
+    while before and not before[-1].strip():
+        before.pop()
+    table = [f"# {line}" for line in (*provenance, f"Written by nctwin on {today.isoformat()}.")]
+    table.append(header)
+    table += [f"{f.name} = {_toml_value(getattr(control, f.name))}" for f in fields(control)]
+    text = "\n".join([*before, "", *table, *([""] if after else []), *after]) + "\n"
+    tmp = p.with_name(p.name + ".tmp")
+    tmp.write_text(text)
+    try:
+        Profile.from_toml(tmp)
+    except ValueError:
+        tmp.unlink()
+        raise
+    tmp.replace(p)
