@@ -26,14 +26,14 @@ from _common import best_time_s, record
 from nctwin.chapters.sun2022 import SEEDS, TRAIN_CONFIG, predict_times, run_pockets
 from nctwin.learn.models import build
 from nctwin.learn.train import Scaler, Trained
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.methods.sun2022 import MODEL_CONFIG, features
 
 
 def main() -> None:
     torch.set_num_threads(1)
-    machine = load_machine("sun2022_siemens")
-    runs = run_pockets(machine)
+    profile = load_profile("sun2022_siemens")
+    runs = run_pockets(profile)
     x = [r.features[:, a] for r in runs.values() for a in range(3)]
     y = [r.measured_feed_mm_s[:, :1] for r in runs.values()]
     members = [
@@ -50,7 +50,8 @@ def main() -> None:
     record("axis_nn_inference_8_pockets_s", round(t, 5), "s", "< 0.05")
     t = best_time_s(lambda: predict_times(members[:1], list(runs.values())))
     record("axis_nn_inference_8_pockets_one_seed_s", round(t, 5), "s", "< 0.05")
-    t = best_time_s(lambda: [features(r.toolpath, machine.rapid_feed_mm_s) for r in runs.values()])
+    rapid_mm_s = profile.machine.rapid_feed_mm_s
+    t = best_time_s(lambda: [features(r.toolpath, rapid_mm_s) for r in runs.values()])
     record("axis_nn_features_8_pockets_s", round(t, 5), "s", "for scale")
 
 

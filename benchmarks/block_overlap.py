@@ -14,16 +14,17 @@ from _common import best_time_s, record
 from nctwin import parse_file
 from nctwin.estimate.block_overlap import block_overlap
 from nctwin.kernel.accdec import simulate
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.programs.iso10791 import shipped_test_piece_path
 
 
 def main() -> None:
     tp = parse_file(shipped_test_piece_path())
-    machine = load_machine("fanuc_0i_testbed")
-    t = best_time_s(lambda: block_overlap(tp, machine))
+    profile = load_profile("fanuc_0i_testbed")
+    machine, control = profile.machine, profile.control("accdec")
+    t = best_time_s(lambda: block_overlap(tp, machine, control))
     record("block_overlap_analytic_s", round(t, 6), "s", "< 0.02")
-    t = best_time_s(lambda: simulate(tp, machine), repeat=3, warmup=1)
+    t = best_time_s(lambda: simulate(tp, machine, control), repeat=3, warmup=1)
     record("accdec_kernel_s", round(t, 4), "s", "< 2")
 
 

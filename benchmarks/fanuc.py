@@ -30,8 +30,8 @@ def main() -> None:
     for name, (tp, target) in programs.items():
         t = best_time_s(lambda tp=tp: simulate(tp, machine), repeat=3, warmup=1)
         record(f"fanuc_kernel_{name}_s", round(t, 4), "s", target)
-        for set_name, settings in (("set1", PAPER_SET_1), ("set2", PAPER_SET_2)):
-            cycle = simulate(tp, machine, settings).cycle_time_s
+        for set_name, control in (("set1", PAPER_SET_1), ("set2", PAPER_SET_2)):
+            cycle = simulate(tp, machine, control).cycle_time_s
             record(f"fanuc_cycle_{name}_{set_name}_s", round(cycle, 3), "s", "")
     for axis, t in zip("xyz", measure_inposition_times(machine), strict=True):
         record(f"fanuc_inposition_{axis}_s", round(float(t), 4), "s", "")

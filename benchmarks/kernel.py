@@ -25,7 +25,7 @@ from _common import SHARED_PROGRAMS, best_time_s, record
 
 from nctwin import parse, parse_file
 from nctwin.kernel import fir
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.programs.pocket import pocket_program
 from nctwin.toolpath import Toolpath
 
@@ -47,16 +47,16 @@ def cold_time_s(fn: Callable[[Toolpath], object], toolpath: Toolpath) -> float:
 
 
 def main() -> None:
-    machine = load_machine("paper1_sim")
-    settings = fir.FirSettings.load("paper1_sim")
+    profile = load_profile("paper1_sim")
+    machine, settings = profile.machine, profile.control("fir")
     # the pocket: about 5000 G-lines and 220 s of motion; at the programmed 50 mm/s
     # the package's pocket runs 4682 lines in 214.5 s (at its default 92 mm/s, 123 s)
     pocket = parse(pocket_program(feed_mm_s=POCKET_FEED_MM_S, tol_mm=0.3))
     samples = len(fir.run(pocket, machine, settings))
     t = cold_time_s(lambda tp: fir.run(tp, machine, settings), pocket)
     record("kernel_pocket5000_s", round(t, 4), "s", "< 0.3")
-    flt = fir.FirFilter.of(settings, machine.period_s)
-    tplan = cold_time_s(lambda tp: fir.plan(tp, machine, flt), pocket)
+    flt = fir.FirFilter.of(settings)
+    tplan = cold_time_s(lambda tp: fir.plan(tp, machine, settings), pocket)
     record("kernel_pocket5000_plan_s", round(tplan, 4), "s", "")
     record("kernel_sample_stage_samples_per_s", round(samples / (t - tplan)), "samples/s", "")
     x = fir.run(pocket, machine, settings).pos_mm.T.copy()  # (3, n) samples to filter

@@ -1,13 +1,14 @@
 """The ``nctwin`` command line: ``estimate``, ``simulate`` and ``machines``.
 
-``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with
-:func:`nctwin.estimate.default_method`); ``nctwin simulate PROGRAM`` interpolates it on the FIR
-kernel and can write the feed plot and the sampled motion; ``nctwin machines`` lists the shipped
-machine profiles. ``-`` reads the program from standard input. Bad input ends with exit code 2
-and one line on standard error, never a traceback: ``file:line: reason`` for a line of the
-program that cannot be read (one such line per error the reader lists), ``file: reason`` for a
-file that is not a program (absent, a directory, binary, no motion), ``nctwin: reason`` for the
-rest (a bad machine profile or argument, an output file that cannot be written).
+``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the
+machine profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR
+kernel (the profile's ``[control.fir]``) and can write the feed plot and the sampled motion;
+``nctwin machines`` lists the shipped machine profiles. ``-`` reads the program from standard
+input. Bad input ends with exit code 2 and one line on standard error, never a traceback:
+``file:line: reason`` for a line of the program that cannot be read (one such line per error
+the reader lists), ``file: reason`` for a file that is not a program (absent, a directory,
+binary, no motion), ``nctwin: reason`` for the rest (a bad machine profile or argument, an
+output file that cannot be written).
 """
 
 from __future__ import annotations
@@ -23,11 +24,10 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .estimate import METHODS, default_method, estimate
-from .estimate.kernel import fir_settings
+from .estimate import METHODS, estimate
 from .gcode import READERS, GCodeError, read
 from .kernel import fir
-from .machine import DEFAULT_MACHINE, MachineProfile, available_machines, load_machine
+from .machine import DEFAULT_MACHINE, Machine, Profile, available_machines, load_profile
 from .motion import Motion
 from .toolpath import MotionKind, Toolpath
 
@@ -167,8 +167,8 @@ def _parser() -> argparse.ArgumentParser:
         "--method",
         default=None,
         choices=sorted(METHODS),
-        help="estimator (default: the best one a chapter found for the machine, cam for most; "
-        "bilstm and axis_nn need a machine with recordings: linuxcnc_sim)",
+        help="estimator (default: the machine profile's default_method; each needs its control "
+        "table in the profile; bilstm and axis_nn need a profile with recordings: linuxcnc_sim)",
     )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
@@ -281,8 +281,8 @@ def program_units(text: str, default: str = "mm") -> str:
     return "inch" if match.group(1) == "0" else "mm"
 
 
-def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Toolpath, str, str]:
-    """The machine, the parsed program, its text and the reader that read it (``native`` or
+def _load(args: argparse.Namespace, stage: _Stages) -> tuple[Profile, Toolpath, str, str]:
+    """The machine profile, the parsed program, its text and the reader that read it (``native`` or
     ``linuxcnc``; subroutine files are looked up beside the program).
 
     Raises
@@ -291,7 +291,7 @@ def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Too
         If the program has no motion (no move of non-zero length and no dwell).
     """
     stage("machine")
-    machine = load_machine(args.machine)
+    profile = load_profile(args.machine)
     stage("read")
     text, source = _read_program(args.program)
     stage("parse")
@@ -307,7 +307,7 @@ def _load(args: argparse.Namespace, stage: _Stages) -> tuple[MachineProfile, Too
     tp = result.toolpath
     if not ((tp.lengths_mm > 0).any() or (tp.dwell_s > 0).any()):
         raise InputError(f"{source}: no motion")
-    return machine, tp, text, result.reader
+    return profile, tp, text, result.reader
 
 
 def _report(summary: dict, rows: list[tuple[str, str]], extra: list[str], as_json: bool) -> int:
@@ -346,11 +346,12 @@ def _estimate(args: argparse.Namespace, enabled: bool) -> int:
     method = args.method
     stage = _Stages(["machine", "read", "parse", "estimate"], enabled)
     try:
-        machine, tp, _, reader = _load(args, stage)
-        method = method or default_method(machine)
+        profile, tp, _, reader = _load(args, stage)
+        method = method or profile.default_method
+        profile.control_for(method)  # a profile without the method's control: one line
         learned = method in ("bilstm", "axis_nn")
         stage(f"estimate: {method}" + (" (trains on first use)" if learned else ""))
-        result = estimate(tp, machine, method)
+        result = estimate(tp, profile, method)
     finally:
         stage.close()
     summary = {"program": _program_name(args), "reader": reader, **result.summary()}
@@ -372,7 +373,7 @@ def _estimate(args: argparse.Namespace, enabled: bool) -> int:
     return _report(summary, rows, table, args.json)
 
 
-def _feed_plot(motion: Motion, tp: Toolpath, machine: MachineProfile, feed_unit: str, title: str):
+def _feed_plot(motion: Motion, tp: Toolpath, machine: Machine, feed_unit: str, title: str):
     """The :class:`~nctwin.report.plots.FeedPlot` of a simulated program, in ``feed_unit``
     (a key of :data:`FEED_UNITS`), thinned to at most :data:`PLOT_MAX_SAMPLES` samples."""
     from .report.plots import FeedPlot
@@ -417,9 +418,10 @@ def _simulate(args: argparse.Namespace, enabled: bool) -> int:
     stages += ["plot"] * bool(args.plot) + ["csv"] * bool(args.csv)
     stage = _Stages(stages, enabled)
     try:
-        machine, tp, text, reader = _load(args, stage)
+        profile, tp, text, reader = _load(args, stage)
+        machine = profile.machine
         stage("simulate (FIR kernel)")
-        motion = fir.run(tp, machine, fir_settings(machine))
+        motion = fir.run(tp, machine, profile.control("fir"))
         feed_unit = args.units or (
             "in/min" if program_units(text, args.input_units) == "inch" else "mm/min"
         )
@@ -492,7 +494,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "machines":
             for name in available_machines():
-                print(f"{name:<16} {load_machine(name).description}")
+                print(f"{name:<16} {load_profile(name).machine.description}")
             return 0
         if args.command == "simulate":
             return _simulate(args, enabled)

@@ -170,9 +170,9 @@ class FanucControl:
     ----------
     period_s : float
         Interpolation period :math:`T_I`; also the servo's sampling period and the period of the
-        samples, in (0, 0.1] s. Default 1 ms: a Fanuc 0i interpolates at 1 ms or 2 ms; 1 ms is the period of
-        nctwin's testbed profile (``fanuc_0i_testbed``) and divides every time constant of the
-        paper.
+        samples, in (0, 0.1] s. Default 1 ms: a Fanuc 0i interpolates at 1 ms or 2 ms; 1 ms is
+        the period of nctwin's testbed profile (``fanuc_0i_testbed``) and divides every time
+        constant of the paper.
     cut_accdec : {"linear", "bell", "exponential"}
         Acc/dec type after interpolation for cutting feed (No. 1610). Default ``"linear"``: the
         paper's testbed (its Fig. 1 and 2 are trapezoids). ``"bell"`` is two moving averages

@@ -1,10 +1,11 @@
 r"""Machine constants identified from recordings: what a user of a control need not know, fitted
 so that a model of it times programs as the control does.
 
-* :func:`identified_block_overlap_machine`: Lee et al. (2022)'s time constants from a machine's
+* :func:`identified_block_overlap`: Lee et al. (2022)'s time constants from a machine's
   acceleration limits;
-* :func:`fit_fir`: the FIR kernel's settings (:class:`~nctwin.kernel.fir.FirSettings`) by a
-  grid search on recorded cycle times;
+* :func:`fit_fir`: the FIR kernel's settings (:class:`~nctwin.controls.FirControl`) by a
+  grid search on recorded cycle times; :func:`calibrate_fir` fits them to a profile's shipped
+  recordings and writes them into the profile's file (``nctwin calibrate``);
 * :func:`fit_planner`: the blend-arc planner's six axis limits by least squares on recorded
   cycle times.
 """
@@ -15,32 +16,38 @@ import dataclasses
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import date
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
+from .controls import AccDecControl, FirControl, PlannerControl
 from .estimate.blend_planner import blend_planner
 from .estimate.kernel import kernel
-from .kernel.fir import FirSettings
-from .machine import MachineProfile
+from .machine import Machine, Profile, profile_path, write_control
 from .report.tables import error_pct
 from .runner import run_tasks
 from .toolpath import MotionKind, Toolpath
 
 __all__ = [
     "FIR_FIELDS",
+    "FIR_GRID",
     "PLANNER_FIT_START",
     "PlannerFit",
+    "calibrate_fir",
     "fir_fields",
+    "fir_fit_programs",
     "fit_fir",
     "fit_planner",
-    "identified_block_overlap_machine",
+    "identified_block_overlap",
 ]
 
 
-def identified_block_overlap_machine(tp: Toolpath, machine: MachineProfile) -> MachineProfile:
-    """``machine`` with Lee et al.'s time constants identified from its acceleration limits.
+def identified_block_overlap(tp: Toolpath, machine: Machine, period_s: float) -> AccDecControl:
+    """The acc/dec control of Lee et al.'s estimator with its time constants identified from
+    ``machine``'s acceleration limits, for a control of servo period ``period_s``.
 
     A linear acc/dec filter of time constant :math:`A_T` adds :math:`A_T` to a line at feed
     :math:`F`; LinuxCNC, accelerating at :math:`A`, adds :math:`F / A`. So
@@ -56,13 +63,13 @@ def identified_block_overlap_machine(tp: Toolpath, machine: MachineProfile) -> M
         main = values[np.argmax(np.bincount(inverse, weights=tp.lengths_mm[cut]))]
     else:
         main = machine.rapid_feed_mm_s
-    ti = machine.period_s
+    ti = period_s
 
     def periods(t: float) -> float:
         return max(round(t / ti), 1) * ti
 
-    return dataclasses.replace(
-        machine,
+    return AccDecControl(
+        period_s=ti,
         cut_time_constant_s=periods(main / a),
         rapid_time_constant_s=periods(machine.rapid_feed_mm_s / a),
         rapid_bell_s=0.0,
@@ -71,16 +78,25 @@ def identified_block_overlap_machine(tp: Toolpath, machine: MachineProfile) -> M
     )
 
 
-#: Names of the :class:`~nctwin.kernel.fir.FirSettings` that :func:`fit_fir` fits, as its grid
-#: and trials name them.
+#: Names of the :class:`~nctwin.controls.FirControl` settings that :func:`fit_fir` fits, as
+#: its grid and trials name them.
 FIR_FIELDS = ("fir_t1_s", "fir_t2_s", "fir_acc_scale", "fir_blend_ratio", "fir_block_periods")
+
+#: The grid of the FIR kernel's settings :func:`calibrate_fir` searches (and the chapter
+#: "Predicting a real controller").
+FIR_GRID = {"fir_t1_s": [0.03, 0.045, 0.06, 0.09], "fir_t2_s": [0.003, 0.01],
+            "fir_acc_scale": [2.0, 4.0, 8.0], "fir_blend_ratio": [float("inf"), 0.25],
+            "fir_block_periods": [0, 2]}  # fmt: skip
+
+#: Every how many-th training recording the fits use (:func:`fir_fit_programs`).
+FIT_EVERY = 5
 
 
 def _fir_trial(
-    programs: Sequence[tuple[Toolpath, float]], machine: MachineProfile, settings: FirSettings
+    programs: Sequence[tuple[Toolpath, float]], machine: Machine, control: FirControl
 ) -> dict:
     measured = np.array([m for _, m in programs])
-    sim = np.array([kernel(tp, machine, settings).cycle_time_s for tp, _ in programs])
+    sim = np.array([kernel(tp, machine, control).cycle_time_s for tp, _ in programs])
     err = error_pct(sim, measured)
     return {
         "score": float(np.abs(np.log(sim / measured)).mean()),
@@ -91,17 +107,18 @@ def _fir_trial(
 
 def fit_fir(
     programs: Sequence[tuple[Toolpath, float]],
-    machine: MachineProfile,
+    machine: Machine,
+    base: FirControl,
     grid: dict[str, Sequence[float]],
     *,
     n_jobs: int = 2,
-) -> tuple[FirSettings, list[dict]]:
+) -> tuple[FirControl, list[dict]]:
     """Fit the FIR kernel's settings to recorded cycle times by a grid search.
 
     LinuxCNC has no jerk limit and accelerates at a constant rate; the FIR kernel accelerates at
     :math:`F / T_1` with jerk :math:`F / (T_1 T_2)`, and caps an axis's feed at
     :math:`a_i T_1`. No single (T1, T2) is LinuxCNC, so the kernel's settings
-    (:class:`~nctwin.kernel.fir.FirSettings`: time constants, acceleration scale, blend ratio,
+    (:class:`~nctwin.controls.FirControl`: time constants, acceleration scale, blend ratio,
     block rate; named :data:`FIR_FIELDS` in the grid and the trials) are fitted: the grid point
     with the lowest mean absolute log ratio of simulated (:func:`nctwin.estimate.kernel.kernel`)
     to recorded cycle time wins.
@@ -110,8 +127,10 @@ def fit_fir(
     ----------
     programs : sequence of (Toolpath, float)
         Training programs and their recorded cycle times.
-    machine : MachineProfile
-        The recorded machine's profile.
+    machine : Machine
+        The recorded machine.
+    base : FirControl
+        The control whose period and tolerance the fit keeps.
     grid : dict
         Values to try for each field of :data:`FIR_FIELDS`.
     n_jobs : int
@@ -119,8 +138,8 @@ def fit_fir(
 
     Returns
     -------
-    best : FirSettings
-        The best grid point.
+    best : FirControl
+        ``base`` with the best grid point's settings.
     trials : list of dict
         Every grid point with its score, mean and largest absolute error (%).
     """
@@ -128,20 +147,88 @@ def fit_fir(
         raise ValueError(f"grid has keys {sorted(grid)}: allowed exactly {list(FIR_FIELDS)}")
     values = itertools.product(*(grid[n] for n in FIR_FIELDS))
     points = [dict(zip(FIR_FIELDS, v, strict=True)) for v in values]
-    tasks = ((programs, machine, _fir_settings(p)) for p in points)
+    tasks = ((programs, machine, _fir_control(base, p)) for p in points)
     scores = run_tasks(_fir_trial, tasks, n_jobs=n_jobs)
     trials = [p | r for p, r in zip(points, scores, strict=True)]
-    return _fir_settings(min(trials, key=lambda r: r["score"])), trials
+    return _fir_control(base, min(trials, key=lambda r: r["score"])), trials
 
 
-def _fir_settings(row: dict) -> FirSettings:
-    """The settings of a grid point (:data:`FIR_FIELDS` are the settings' fields, prefixed)."""
-    return FirSettings(**{n.removeprefix("fir_"): row[n] for n in FIR_FIELDS})
+def _fir_control(base: FirControl, row: dict) -> FirControl:
+    """``base`` with the settings of a grid point (:data:`FIR_FIELDS` are the control's
+    fields, prefixed)."""
+    return dataclasses.replace(base, **{n.removeprefix("fir_"): row[n] for n in FIR_FIELDS})
 
 
-def fir_fields(settings: FirSettings) -> dict:
-    """``settings`` as a grid point of :func:`fit_fir`: :data:`FIR_FIELDS` -> value."""
-    return {n: getattr(settings, n.removeprefix("fir_")) for n in FIR_FIELDS}
+def fir_fields(control: FirControl) -> dict:
+    """``control`` as a grid point of :func:`fit_fir`: :data:`FIR_FIELDS` -> value."""
+    return {n: getattr(control, n.removeprefix("fir_")) for n in FIR_FIELDS}
+
+
+def fir_fit_programs(training: Sequence) -> list[tuple[Toolpath, float]]:
+    """The recordings the fits use: every :data:`FIT_EVERY`-th of ``training`` (the
+    :class:`~nctwin.estimate.learned.MoveData` of the training sets, in their order), as
+    (moves, recorded cycle time)."""
+    return [(x.moves, x.measured_s) for x in training[::FIT_EVERY]]
+
+
+def calibrate_fir(
+    profile: str | Path, output: str | Path, *, today: date, n_jobs: int = 2
+) -> tuple[FirControl, list[dict], list[str]]:
+    """Fit the FIR kernel to a profile's shipped recordings and write it into a profile file.
+
+    The programs are :func:`fir_fit_programs` of the profile's training recordings
+    (:func:`nctwin.estimate.learned.training_data`), the grid :data:`FIR_GRID`, the period and
+    the tolerance those of the profile's ``[control.fir]`` (else of its ``[control.planner]``).
+    The best control is written as the ``[control.fir]`` table of ``output`` (a copy of the
+    profile's file where ``output`` is another file), with a comment that says which
+    recordings, when, and the fit's residual.
+
+    Parameters
+    ----------
+    profile : str or Path
+        A shipped profile's name or a profile file with a ``recordings`` key.
+    output : str or Path
+        The profile file to write.
+    today : date
+        Written into the provenance comment.
+    n_jobs : int
+        Workers of the grid search.
+
+    Returns
+    -------
+    control : FirControl
+    trials : list of dict
+        Every grid point (:func:`fit_fir`).
+    provenance : list of str
+        The comment written above the table.
+    """
+    from .estimate.learned import training_data
+
+    source = profile_path(profile)
+    loaded = Profile.from_toml(source)
+    base = loaded.fir
+    if base is None:
+        planner = loaded.control("planner")
+        base = FirControl(period_s=planner.period_s, blend_tol_mm=planner.blend_tol_mm)
+    training = training_data(loaded)
+    programs = fir_fit_programs(training)
+    best, trials = fit_fir(programs, loaded.machine, base, FIR_GRID, n_jobs=n_jobs)
+    row = min(trials, key=lambda r: r["score"])
+    names = [x.name for x in training[::FIT_EVERY]]
+    provenance = [
+        "The FIR kernel fitted to the recorded cycle times of this machine: `nctwin calibrate",
+        f"--recordings {loaded.recordings}` (nctwin.identify.calibrate_fir), a grid search of "
+        f"{np.prod([len(v) for v in FIR_GRID.values()])} points",
+        f"(nctwin.identify.FIR_GRID) on {len(programs)} recordings, every {FIT_EVERY}th of the "
+        f"training sets ({names[0]} ... {names[-1]}).",
+        f"Residual: cycle time off by {row['mean_err_pct']:.2f} % on average, "
+        f"{row['max_err_pct']:.2f} % at worst.",
+    ]
+    out = Path(output)
+    if out.resolve() != source.resolve():
+        out.write_text(source.read_text())
+    write_control(out, "fir", best, provenance, today=today)
+    return best, trials, provenance
 
 
 #: Generic start of :func:`fit_planner`: every axis at this acceleration (mm/s^2) and velocity
@@ -155,8 +242,8 @@ class PlannerFit:
 
     Parameters
     ----------
-    machine : MachineProfile
-        The profile with the identified axis limits.
+    machine : Machine
+        The machine with the identified axis limits.
     limits : DataFrame
         One row per axis and limit: ``axis``, ``limit`` (``acceleration_mm_s2`` or
         ``velocity_mm_s``), ``start``, ``fitted``, ``profile`` (the value the profile had).
@@ -166,7 +253,7 @@ class PlannerFit:
         Planner runs over the programs the fit took.
     """
 
-    machine: MachineProfile
+    machine: Machine
     limits: pd.DataFrame
     mean_err_pct: float
     max_err_pct: float
@@ -175,7 +262,8 @@ class PlannerFit:
 
 def fit_planner(
     programs: Sequence[tuple[Toolpath, float]],
-    machine: MachineProfile,
+    machine: Machine,
+    control: PlannerControl,
     start: tuple[float, float] = PLANNER_FIT_START,
 ) -> PlannerFit:
     r"""Identify the blend-arc planner's axis limits from recorded cycle times.
@@ -191,15 +279,17 @@ def fit_planner(
     planned time a step function of the limits, which finite differences cannot follow. The
     velocities are bounded by the profile's maximum feed
     (``[TRAJ] MAX_LINEAR_VELOCITY``): an axis limit above the path's is never reached, and no
-    recording can tell it. Everything else in the profile (maximum and rapid feed, servo period,
-    default tolerance) is kept.
+    recording can tell it. Everything else (the machine's maximum and rapid feed, the control's
+    servo period and default tolerance) is kept.
 
     Parameters
     ----------
     programs : sequence of (Toolpath, float)
         Training programs and their recorded cycle times.
-    machine : MachineProfile
-        The recorded machine's profile (its axis limits are only reported, not used).
+    machine : Machine
+        The recorded machine (its axis limits are only reported, not used).
+    control : PlannerControl
+        The planner's period and default tolerance.
     start : (float, float)
         Acceleration (mm/s^2) and velocity (mm/s) every axis starts from.
 
@@ -227,7 +317,7 @@ def fit_planner(
             f"velocity [1, {machine.max_feed_mm_s:g}] mm/s"
         )
 
-    def profile(x: np.ndarray) -> MachineProfile:
+    def profile(x: np.ndarray) -> Machine:
         e = np.exp(x)
         return dataclasses.replace(
             machine,
@@ -235,10 +325,11 @@ def fit_planner(
             axis_max_velocity_mm_s=tuple(float(v) for v in e[3:]),
         )
 
-    def planned_s(m: MachineProfile, stop_periods: str) -> np.ndarray:
+    def planned_s(m: Machine, stop_periods: str) -> np.ndarray:
         return np.array(
-            [blend_planner(tp, m, stop_periods=stop_periods).cycle_time_s for tp, _ in programs]
-        )
+            [blend_planner(tp, m, control, stop_periods=stop_periods).cycle_time_s
+             for tp, _ in programs]
+        )  # fmt: skip
 
     def residual(x: np.ndarray) -> np.ndarray:
         return np.log(planned_s(profile(x), "mean") / measured)

@@ -23,7 +23,7 @@ from .cache import atomic_write_text
 from .estimate.cam import cam as estimate_cam
 from .gcode import GCodeError, parse
 from .kernel import linuxcnc
-from .machine import MachineProfile, load_machine
+from .machine import Profile, load_profile
 from .paths import public_programs_dir
 from .programs.camstyle import cam_program
 from .programs.language import LANGUAGE_PROGRAMS
@@ -169,7 +169,7 @@ def _q0(text: str, tol_mm: float) -> str:
 def record_program(
     name: str,
     program: str,
-    machine: MachineProfile,
+    profile: Profile,
     *,
     speed: float = 5,
     source: str = "nctwin",
@@ -184,7 +184,13 @@ def record_program(
     tp = parse(program)
     for attempt in range(RETRIES + 1):
         try:
-            motion = linuxcnc.run(program, machine, speed=speed, timeout_s=timeout_s)
+            motion = linuxcnc.run(
+                program,
+                profile.machine,
+                profile.control("planner"),
+                speed=speed,
+                timeout_s=timeout_s,
+            )
             break
         except linuxcnc.LinuxCNCAborted:
             if attempt == RETRIES:
@@ -197,7 +203,7 @@ def record_program(
         program=program if source == "nctwin" else "",
         program_sha256=text_sha256(program),
         source=source,
-        machine=machine.name,
+        machine=profile.name,
         targets=block_targets(motion, tp),
         feed_mm_s=motion.speed_mm_s[::step].astype(np.float32),
         n_samples=len(motion),
@@ -227,17 +233,17 @@ def record_set(
         Which programs (see :func:`recording_programs`).
     """
     folder = recording_dir() if folder is None else Path(folder)
-    machine = load_machine(MACHINE)
+    profile = load_profile(MACHINE)
     programs = recording_programs(sets)
-    tasks = ((n, t, machine, speed) for n, t in programs.items())
+    tasks = ((n, t, profile, speed) for n, t in programs.items())
     out = run_tasks(_record_one, tasks, n_jobs=n_jobs, threads=True, desc="LinuxCNC")
     for rec in out:
         rec.save(folder)
     return out
 
 
-def _record_one(name: str, program: str, machine: MachineProfile, speed: float) -> RecordedProgram:
-    return record_program(name, program, machine, speed=speed)
+def _record_one(name: str, program: str, profile: Profile, speed: float) -> RecordedProgram:
+    return record_program(name, program, profile, speed=speed)
 
 
 #: Suffixes of the public programs that are recorded.
@@ -245,18 +251,18 @@ PUBLIC_SUFFIXES = (".ngc", ".nc", ".gcode")
 
 
 def _record_public_one(
-    path: Path, machine: MachineProfile, speed: float
+    path: Path, profile: Profile, speed: float
 ) -> RecordedProgram | tuple[str, str]:
     text = path.read_text(encoding="utf-8", errors="replace")
     try:
         tp = parse(text, source=path.name)
-        cam_s = estimate_cam(tp, machine).cycle_time_s
+        cam_s = estimate_cam(tp, profile.machine).cycle_time_s
         # generous: LinuxCNC takes up to several times the CAM time on short segments
         timeout_s = 120.0 + 20.0 * cam_s / speed
         return record_program(
             f"public_{path.stem}",
             text,
-            machine,
+            profile,
             speed=speed,
             source=f"public/{path.name}",
             timeout_s=timeout_s,
@@ -295,9 +301,9 @@ def record_public(
     out = recording_dir() if out is None else Path(out)
     if not folder.is_dir():
         raise ValueError(f"{folder} is not a folder of public programs")
-    machine = load_machine(MACHINE)
+    profile = load_profile(MACHINE)
     paths = sorted(p for p in folder.iterdir() if p.suffix in PUBLIC_SUFFIXES)
-    tasks = ((p, machine, speed) for p in paths)
+    tasks = ((p, profile, speed) for p in paths)
     recorded, rejected = [], {}
     for res in run_tasks(
         _record_public_one, tasks, n_jobs=n_jobs, threads=True, desc="LinuxCNC public"

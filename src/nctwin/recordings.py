@@ -42,6 +42,7 @@ from .targets import BlockTargets
 
 __all__ = [
     "MACHINE",
+    "NAME",
     "PUBLIC_REJECTED",
     "TRACE_PERIOD_S",
     "RecordedProgram",
@@ -54,6 +55,11 @@ __all__ = [
 
 #: Profile of the shipped recordings.
 MACHINE = "linuxcnc_sim"
+
+#: Name of the shipped recordings (their folder under ``data/recordings/``; a profile's
+#: ``recordings`` key).
+NAME = "linuxcnc"
+
 #: Period of the shipped feed trace (s).
 TRACE_PERIOD_S = 0.01
 
@@ -142,7 +148,7 @@ class RecordedProgram:
 
 def recording_dir() -> Path:
     """Folder of the shipped LinuxCNC recordings."""
-    return data_dir() / "recordings" / "linuxcnc"
+    return data_dir() / "recordings" / NAME
 
 
 def trace_sha256(motion: Motion) -> str:

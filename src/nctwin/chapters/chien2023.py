@@ -55,12 +55,11 @@ import pandas as pd
 from .. import gcode
 from ..cache import atomic_savez, cache_path, content_key
 from ..estimate import cam
-from ..estimate.kernel import fir_settings
 from ..kernel import fir
 from ..learn.models import ModelConfig
 from ..learn.seeds import fit_seeds
 from ..learn.train import TrainConfig, Trained
-from ..machine import MachineProfile
+from ..machine import Profile
 from ..methods import chien2023 as chien
 from ..motion import Motion
 from ..physics.measure import Recording
@@ -190,30 +189,32 @@ def cutting_blocks(tp: Toolpath) -> Toolpath:
 
 
 def simulate_one(
-    text: str, machine: MachineProfile, recording: Recording | None = None, index: int = 0
+    text: str, profile: Profile, recording: Recording | None = None, index: int = 0
 ) -> ProgramRun:
-    """Parse ``text``, keep its cutting blocks, run them on the FIR kernel and read the targets.
+    """Parse ``text``, keep its cutting blocks, run them on the FIR kernel (the profile's
+    machine and ``[control.fir]``) and read the targets.
 
     ``index`` seeds the recording's noise together with ``recording.seed``.
     """
     tp = cutting_blocks(gcode.parse(text))
-    motion = fir.run(tp, machine, fir_settings(machine))
+    control = profile.control("fir")
+    motion = fir.run(tp, profile.machine, control)
     if recording is not None:
         motion = recording.apply(motion, np.random.default_rng([recording.seed, index]))
     bt = block_targets(motion, tp)
     lengths = tp.lengths_mm
     targets = np.column_stack([bt.avg_feed_mm_s, tp.feed_mm_s * bt.time_s / lengths])
     return ProgramRun(
-        chien.features(tp, machine.blend_tol_mm),
+        chien.features(tp, control.blend_tol_mm),
         targets,
         bt.time_s,
         bt.cycle_time_s,
-        cam(tp, machine).cycle_time_s,
+        cam(tp, profile.machine).cycle_time_s,
     )
 
 
 def recording_effects(
-    text: str, machine: MachineProfile, recordings: dict[str, Recording], *, short_mm: float = 1.0
+    text: str, profile: Profile, recordings: dict[str, Recording], *, short_mm: float = 1.0
 ) -> pd.DataFrame:
     """How a recording changes the per-G-line targets of one program (the Table 3 diagnosis).
 
@@ -225,7 +226,8 @@ def recording_effects(
     ----------
     text : str
         A G-code program.
-    machine : MachineProfile
+    profile : Profile
+        The machine and its ``[control.fir]``.
     recordings : dict
         ``name -> Recording``; each draws its noise with ``[recording.seed, 0]``.
     short_mm : float
@@ -242,7 +244,7 @@ def recording_effects(
         of G-lines whose two junction points are the same sample (``zero_time_pct``).
     """
     tp = cutting_blocks(gcode.parse(text))
-    motion = fir.run(tp, machine, fir_settings(machine))
+    motion = fir.run(tp, profile.machine, profile.control("fir"))
     lengths = tp.lengths_mm
     short = lengths < short_mm
 
@@ -280,11 +282,11 @@ def recording_effects(
     return pd.DataFrame(rows)
 
 
-def _cache_key(texts: Sequence[str], machine: MachineProfile, recording: Recording | None) -> str:
+def _cache_key(texts: Sequence[str], profile: Profile, recording: Recording | None) -> str:
     meta = {
         "version": CACHE_VERSION,
-        "machine": asdict(machine),
-        "fir": asdict(fir_settings(machine)),
+        "machine": asdict(profile.machine),
+        "fir": asdict(profile.control("fir")),
         "recording": None if recording is None else asdict(recording),
     }
     return content_key(*texts, meta)
@@ -319,7 +321,7 @@ def _load_runs(path) -> list[ProgramRun]:
 
 def simulate(
     texts: Sequence[str],
-    machine: MachineProfile,
+    profile: Profile,
     *,
     recording: Recording | None = None,
     n_jobs: int = 2,
@@ -333,7 +335,8 @@ def simulate(
     ----------
     texts : sequence of str
         G-code programs.
-    machine : MachineProfile
+    profile : Profile
+        The machine and its ``[control.fir]``.
     recording : Recording, optional
         Servo lag and noise of a real control's trace (program ``i`` draws its noise with
         ``[recording.seed, i]``).
@@ -349,10 +352,10 @@ def simulate(
     list of ProgramRun
         In the order of ``texts``.
     """
-    path = cache_path("chien2023", "runs", _cache_key(texts, machine, recording), ".npz")
+    path = cache_path("chien2023", "runs", _cache_key(texts, profile, recording), ".npz")
     if cache and path.exists():
         return _load_runs(path)
-    tasks = ((t, machine, recording, i) for i, t in enumerate(texts))
+    tasks = ((t, profile, recording, i) for i, t in enumerate(texts))
     runs = run_tasks(simulate_one, tasks, n_jobs=n_jobs, desc=desc)
     if cache:
         _save_runs(path, runs)

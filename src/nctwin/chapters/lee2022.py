@@ -1,7 +1,7 @@
 r"""The experiment of Lee et al. (2022): the analytic cycle time with block overlap and
 in-position compensation, tested against a Fanuc-like control that is not its own formula.
 
-The "measured" machine is :mod:`nctwin.kernel.fanuc` (the ``[fanuc]`` table of profile
+The "measured" machine is :mod:`nctwin.kernel.fanuc` (the ``[control.fanuc]`` table of profile
 ``fanuc_0i_testbed`` with the paper's two parameter sets, :func:`parameter_sets`): a
 time-domain control with acc/dec after interpolation, a block-processing time, an arc clamp,
 bell-shaped rapids and servo loops whose in-position waits come out of the simulation. It
@@ -29,13 +29,14 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..estimate import estimate
+from ..controls import AccDecControl, FanucControl
 from ..estimate.block_overlap import block_overlap
+from ..estimate.cam import cam
 from ..gcode import GCodeError, parse, parse_file
-from ..identify import identified_block_overlap_machine
+from ..identify import identified_block_overlap
 from ..kernel import accdec, fanuc
-from ..kernel.fanuc import FanucRun, FanucSettings
-from ..machine import MachineProfile, load_machine
+from ..kernel.fanuc import FanucRun
+from ..machine import Machine, load_profile
 from ..methods.lee2022 import check_program
 from ..paths import data_dir
 from ..programs.finishing3d import finishing3d_program, program_statistics
@@ -91,7 +92,7 @@ VARIANTS = {
 _NO_WAIT_MM = (10.0, 10.0, 10.0)
 #: The truth's effects, each as the settings that switch it on over the estimator's own model
 #: (linear acc/dec, no arc clamp, no block-processing time, no in-position wait). Values are
-#: the testbed's (:class:`~nctwin.kernel.fanuc.FanucSettings` defaults) or, for the
+#: the testbed's (:class:`~nctwin.controls.FanucControl` defaults) or, for the
 #: alternatives the testbed does not use, the other type Fanuc offers.
 EFFECTS = {
     "none (the estimator's model)": {},
@@ -167,16 +168,18 @@ def program_statistics_table(texts: dict[str, str]) -> pd.DataFrame:
 
 def parameter_sets(
     profile: str, paper: pd.DataFrame
-) -> dict[int, tuple[MachineProfile, FanucSettings]]:
-    """The testbed with each of the paper's parameter sets (:math:`A_{TR}`, :math:`A_s`,
-    :math:`A_T`): the profile the estimator reads and the truth's settings.
+) -> dict[int, tuple[AccDecControl, FanucControl]]:
+    """The testbed's controls with each of the paper's parameter sets (:math:`A_{TR}`,
+    :math:`A_s`, :math:`A_T`): the control the estimator reads and the truth's.
+
+    Both run on the testbed's :class:`~nctwin.machine.Machine`
+    (:func:`nctwin.machine.load_machine` of ``profile``), which no set changes.
 
     Parameters
     ----------
     profile : str
-        The testbed's machine profile (``"fanuc_0i_testbed"``): its top level is the
-        estimator's machine, its ``[fanuc]`` table the truth's settings
-        (:meth:`~nctwin.kernel.fanuc.FanucSettings.load`).
+        The testbed's machine profile (``"fanuc_0i_testbed"``): its ``[control.accdec]`` table
+        is the estimator's control, its ``[control.fanuc]`` table the truth's settings.
     paper : pandas.DataFrame
         The paper table ``lee2022_validation`` (``param_set``, ``atr_ms``, ``as_ms``,
         ``at_ms``).
@@ -184,9 +187,10 @@ def parameter_sets(
     Returns
     -------
     dict
-        ``param_set -> (MachineProfile, FanucSettings)`` in the order of the table's rows.
+        ``param_set -> (AccDecControl, FanucControl)`` in the order of the table's rows.
     """
-    base, testbed = load_machine(profile), FanucSettings.load(profile)
+    testbed = load_profile(profile)
+    model, truth = testbed.control("accdec"), testbed.control("fanuc")
     out = {}
     for row in paper.itertuples():
         consts = {
@@ -194,17 +198,19 @@ def parameter_sets(
             "rapid_bell_s": row.as_ms / 1000,
             "cut_time_constant_s": row.at_ms / 1000,
         }
-        machine = dataclasses.replace(base, name=f"{profile}_set{row.param_set}", **consts)
-        out[int(row.param_set)] = (machine, dataclasses.replace(testbed, **consts))
+        out[int(row.param_set)] = (
+            dataclasses.replace(model, **consts),
+            dataclasses.replace(truth, **consts),
+        )
     return out
 
 
 def measure_inposition(
-    sets: dict[int, tuple[MachineProfile, FanucSettings]],
+    machine: Machine, sets: dict[int, tuple[AccDecControl, FanucControl]]
 ) -> dict[int, np.ndarray]:
     """Each set's in-position times of X, Y, Z (s), measured on the truth as the paper did
     (:func:`nctwin.kernel.fanuc.measure_inposition_times`: single-axis rapids from rest)."""
-    return {s: fanuc.measure_inposition_times(m, st) for s, (m, st) in sets.items()}
+    return {s: fanuc.measure_inposition_times(machine, st) for s, (_, st) in sets.items()}
 
 
 def inposition_table(inpos: dict[int, np.ndarray], paper_inpos: pd.DataFrame) -> pd.DataFrame:
@@ -238,7 +244,8 @@ def inposition_table(inpos: dict[int, np.ndarray], paper_inpos: pd.DataFrame) ->
 
 def accuracy_table(
     programs: dict[str, Toolpath],
-    sets: dict[int, tuple[MachineProfile, FanucSettings]],
+    machine: Machine,
+    sets: dict[int, tuple[AccDecControl, FanucControl]],
     inpos: dict[int, np.ndarray],
     paper: pd.DataFrame,
 ) -> tuple[dict[tuple[str, int], FanucRun], pd.DataFrame]:
@@ -248,6 +255,8 @@ def accuracy_table(
     ----------
     programs : dict
         ``name -> Toolpath`` of N blocks each.
+    machine : Machine
+        The testbed, for the truth, the estimator and CAM.
     sets : dict
         :func:`parameter_sets`.
     inpos : dict
@@ -267,12 +276,12 @@ def accuracy_table(
     ref = paper.set_index("param_set")
     runs, rows = {}, []
     for prog, tp in programs.items():
-        for s, (m, st) in sets.items():
-            runs[prog, s] = fanuc.simulate(tp, m, st)
+        for s, (model, truth) in sets.items():
+            runs[prog, s] = fanuc.simulate(tp, machine, truth)
             measured = runs[prog, s].cycle_time_s
-            cam = estimate(tp, m, "cam").cycle_time_s
+            cam_s = cam(tp, machine).cycle_time_s
             for variant, kw in VARIANTS.items():
-                pred = block_overlap(tp, m, inposition_s=inpos[s], **kw).cycle_time_s
+                pred = block_overlap(tp, machine, model, inposition_s=inpos[s], **kw).cycle_time_s
                 beside = prog == TEST_PIECE and variant == "full"
                 rows.append(
                     {
@@ -283,8 +292,8 @@ def accuracy_table(
                         "predicted_s": pred,
                         "accuracy_pct": accuracy_pct(pred, measured),
                         "err_pct": error_pct(pred, measured, signed=True),
-                        "cam_s": cam,
-                        "cam_err_pct": error_pct(cam, measured, signed=True),
+                        "cam_s": cam_s,
+                        "cam_err_pct": error_pct(cam_s, measured, signed=True),
                         "paper_measured_s": ref.loc[s, "measured_s"] if beside else np.nan,
                         "paper_predicted_s": ref.loc[s, "predicted_s"] if beside else np.nan,
                         "paper_accuracy_pct": ref.loc[s, "accuracy_pct"] if beside else np.nan,
@@ -294,10 +303,13 @@ def accuracy_table(
 
 
 def ideal_table(
-    programs: dict[str, Toolpath], sets: dict[int, tuple[MachineProfile, FanucSettings]]
+    programs: dict[str, Toolpath],
+    machine: Machine,
+    sets: dict[int, tuple[AccDecControl, FanucControl]],
 ) -> pd.DataFrame:
     """The sanity rows: the estimator on the ideal machine it was derived for
-    (:mod:`nctwin.kernel.accdec`), with in-position times measured on that machine.
+    (:mod:`nctwin.kernel.accdec`: ``machine`` with each set's acc/dec control), with in-position
+    times measured on that machine.
 
     Returns
     -------
@@ -305,11 +317,11 @@ def ideal_table(
         ``program, param_set, measured_s, predicted_s, accuracy_pct, err_pct``.
     """
     rows = []
-    for s, (m, _) in sets.items():
-        inpos = accdec.measure_inposition_times(m).mean_s
+    for s, (model, _) in sets.items():
+        inpos = accdec.measure_inposition_times(machine, model).mean_s
         for prog, tp in programs.items():
-            measured = accdec.simulate(tp, m).cycle_time_s
-            pred = block_overlap(tp, m, inposition_s=inpos).cycle_time_s
+            measured = accdec.simulate(tp, machine, model).cycle_time_s
+            pred = block_overlap(tp, machine, model, inposition_s=inpos).cycle_time_s
             rows.append(
                 {"program": prog, "param_set": s, "measured_s": measured, "predicted_s": pred,
                  "accuracy_pct": accuracy_pct(pred, measured),
@@ -318,7 +330,7 @@ def ideal_table(
     return pd.DataFrame(rows)
 
 
-def _effect_settings(testbed: FanucSettings, changes: dict | None) -> FanucSettings:
+def _effect_settings(testbed: FanucControl, changes: dict | None) -> FanucControl:
     """The truth with one effect on: the estimator's model plus ``changes`` (None values take
     the testbed's value; ``changes`` None is the testbed itself)."""
     if changes is None:
@@ -331,7 +343,9 @@ def _effect_settings(testbed: FanucSettings, changes: dict | None) -> FanucSetti
 
 
 def truth_effects_table(
-    programs: dict[str, Toolpath], sets: dict[int, tuple[MachineProfile, FanucSettings]]
+    programs: dict[str, Toolpath],
+    machine: Machine,
+    sets: dict[int, tuple[AccDecControl, FanucControl]],
 ) -> pd.DataFrame:
     """The estimator against truths that have only one effect switched on (:data:`EFFECTS`).
 
@@ -346,12 +360,12 @@ def truth_effects_table(
     """
     rows = []
     for effect, changes in EFFECTS.items():
-        for s, (m, testbed) in sets.items():
+        for s, (model, testbed) in sets.items():
             st = _effect_settings(testbed, changes)
-            inpos = fanuc.measure_inposition_times(m, st)
+            inpos = fanuc.measure_inposition_times(machine, st)
             for prog, tp in programs.items():
-                measured = fanuc.simulate(tp, m, st).cycle_time_s
-                pred = block_overlap(tp, m, inposition_s=inpos).cycle_time_s
+                measured = fanuc.simulate(tp, machine, st).cycle_time_s
+                pred = block_overlap(tp, machine, model, inposition_s=inpos).cycle_time_s
                 rows.append(
                     {"effect": effect, "program": prog, "param_set": s, "measured_s": measured,
                      "predicted_s": pred, "accuracy_pct": accuracy_pct(pred, measured),
@@ -363,7 +377,8 @@ def truth_effects_table(
 
 def out_of_domain_table(recordings: dict[str, RecordedProgram]) -> pd.DataFrame:
     """The estimator on LinuxCNC's recordings, its time constants identified from the machine
-    (:func:`nctwin.identify.identified_block_overlap_machine`), per group of recordings.
+    (:func:`nctwin.identify.identified_block_overlap`, at LinuxCNC's servo period, the
+    profile's ``[control.planner]`` ``period_s``), per group of recordings.
 
     Parameters
     ----------
@@ -389,10 +404,12 @@ def out_of_domain_table(recordings: dict[str, RecordedProgram]) -> pd.DataFrame:
         if tp is None:
             g["not_read"].append(name)
             continue
-        machine = load_machine(rec.machine)
-        pred = block_overlap(tp, identified_block_overlap_machine(tp, machine)).cycle_time_s
+        profile = load_profile(rec.machine)
+        machine = profile.machine
+        lee = identified_block_overlap(tp, machine, profile.control("planner").period_s)
+        pred = block_overlap(tp, machine, lee).cycle_time_s
         g["err"].append(error_pct(pred, rec.cycle_time_s, signed=True))
-        g["cam"].append(error_pct(estimate(tp, machine, "cam").cycle_time_s, rec.cycle_time_s))
+        g["cam"].append(error_pct(cam(tp, machine).cycle_time_s, rec.cycle_time_s))
     return pd.DataFrame(
         [
             {"group": k, "programs": len(g["err"]), "not_read": len(g["not_read"]),
@@ -461,14 +478,14 @@ def claims(accuracy: pd.DataFrame) -> list[Claim]:
 
 
 def _speed(
-    text: str, machine: MachineProfile, settings: FanucSettings, start_mm: tuple[float, ...]
+    text: str, machine: Machine, truth: FanucControl, start_mm: tuple[float, ...]
 ) -> tuple[np.ndarray, np.ndarray]:
     """Measured path speed (mm/min) over time of a program run on the truth."""
-    motion = fanuc.simulate(parse(text, start_mm=start_mm), machine, settings).motion
+    motion = fanuc.simulate(parse(text, start_mm=start_mm), machine, truth).motion
     return motion.t_s, motion.speed_mm_s * 60
 
 
-def plot_overlap_profiles(sets: dict[int, tuple[MachineProfile, FanucSettings]]):
+def plot_overlap_profiles(machine: Machine, sets: dict[int, tuple[AccDecControl, FanucControl]]):
     """Block overlap on the truth (the paper's Fig. 6-7): three 20 mm cutting blocks with set 1
     and five 0.87 mm chords with set 2, each once overlapped and once with an exact stop (a
     zero-length dwell) between blocks; only draws.
@@ -488,8 +505,8 @@ def plot_overlap_profiles(sets: dict[int, tuple[MachineProfile, FanucSettings]])
         (axes[1], chords, 2, "short blocks, $A_T$ = 100 ms"),
     ):
         start = (0.0, 0.0, 0.0) if blocks is lines else (10.0, 0.0, 0.0)
-        t, v = _speed("\n".join(blocks), *sets[s], start)
-        t2, v2 = _speed("\nG4 X0\n".join(blocks), *sets[s], start)
+        t, v = _speed("\n".join(blocks), machine, sets[s][1], start)
+        t2, v2 = _speed("\nG4 X0\n".join(blocks), machine, sets[s][1], start)
         ax.plot(t2, v2, label="no overlap (exact stop)", color="tab:gray", ls="--")
         ax.plot(t, v, label="block overlap", color="tab:blue")
         ax.set(xlabel="time (s)", ylabel="path speed (mm/min)", title=title)
@@ -501,7 +518,8 @@ def plot_overlap_profiles(sets: dict[int, tuple[MachineProfile, FanucSettings]])
 def plot_block_errors(
     runs: dict[tuple[str, int], FanucRun],
     tp: Toolpath,
-    sets: dict[int, tuple[MachineProfile, FanucSettings]],
+    machine: Machine,
+    sets: dict[int, tuple[AccDecControl, FanucControl]],
     inpos: dict[int, np.ndarray],
     program: str,
 ):
@@ -514,7 +532,7 @@ def plot_block_errors(
         ``(program, param_set) -> FanucRun`` (:func:`accuracy_table`).
     tp : Toolpath
         The program, N blocks.
-    sets, inpos
+    machine, sets, inpos
         As for :func:`accuracy_table`.
     program : str
         The program's name in ``runs``.
@@ -532,8 +550,8 @@ def plot_block_errors(
         "rapids (G0) and dwells": np.isin(tp.kind, (MotionKind.RAPID, MotionKind.DWELL)),
     }
     idx = np.arange(len(tp))
-    for (s, (m, _)), ls in zip(sets.items(), ("-", "--"), strict=True):
-        err = block_overlap(tp, m, inposition_s=inpos[s]).block_times_s
+    for (s, (model, _)), ls in zip(sets.items(), ("-", "--"), strict=True):
+        err = block_overlap(tp, machine, model, inposition_s=inpos[s]).block_times_s
         err = err - runs[program, s].block_times_s
         for (label, mask), c in zip(kinds.items(), ("tab:blue", "tab:orange", "tab:red"),
                                     strict=True):  # fmt: skip

@@ -6,9 +6,9 @@ recordings are shipped (:mod:`nctwin.recordings`). The methods compared:
 
 * ``cam``: length over feed (:func:`nctwin.estimate.cam.cam`);
 * ``block_overlap``: Lee et al. (2022), with its time constants identified from LinuxCNC's
-  acceleration limits (:func:`nctwin.identify.identified_block_overlap_machine`);
+  acceleration limits (:func:`nctwin.identify.identified_block_overlap`);
 * ``kernel``: nctwin's FIR kernel with its settings fitted to the training recordings
-  (:func:`nctwin.identify.fit_fir`);
+  (:func:`nctwin.identify.fit_fir`; the same fit ``nctwin calibrate`` writes into the profile);
 * ``bilstm``: Chien et al. (2023)'s BiLSTM trained on the recordings
   (:func:`nctwin.estimate.learned.train_bilstm`);
 * ``axis_nn``: Sun et al. (2022)'s per-axis networks trained on the recordings
@@ -29,6 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from ..controls import FirControl
 from ..estimate.blend_planner import blend_planner
 from ..estimate.block_overlap import block_overlap
 from ..estimate.cam import cam
@@ -41,17 +42,15 @@ from ..estimate.learned import (
     recorded_move_data,
 )
 from ..gcode import parse
-from ..identify import identified_block_overlap_machine
-from ..kernel.fir import FirSettings
+from ..identify import identified_block_overlap
 from ..learn.train import Trained
-from ..machine import MachineProfile
+from ..machine import Machine, Profile
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, error_pct
 from ..toolpath import MotionKind, PathMode, Toolpath
 
 __all__ = [
     "EVERY_PROGRAM_SETS",
-    "FIR_GRID",
     "METHOD_COLUMNS",
     "PLANNER_RULES",
     "analytic_times",
@@ -67,20 +66,21 @@ __all__ = [
 
 def analytic_times(
     tp: Toolpath,
-    machine: MachineProfile,
-    fir_fitted: FirSettings,
-    planner_fitted: MachineProfile,
+    profile: Profile,
+    fir_fitted: FirControl,
+    planner_fitted: Machine,
 ) -> dict:
     """Cycle times of the methods that need no training data, or only constants fitted to it:
     CAM, Lee's block overlap with identified constants, the fitted FIR kernel, the blend-arc
     planner (:mod:`nctwin.estimate.blend_planner`) and the same with fitted axis limits."""
-    lee = identified_block_overlap_machine(tp, machine)
+    machine, planner = profile.machine, profile.control("planner")
+    lee = identified_block_overlap(tp, machine, planner.period_s)
     return {
         "cam": cam(tp, machine).cycle_time_s,
-        "block_overlap": block_overlap(tp, lee).cycle_time_s,
+        "block_overlap": block_overlap(tp, machine, lee).cycle_time_s,
         "kernel": kernel(tp, machine, fir_fitted).cycle_time_s,
-        "planner": blend_planner(tp, machine).cycle_time_s,
-        "planner_fitted": blend_planner(tp, planner_fitted).cycle_time_s,
+        "planner": blend_planner(tp, machine, planner).cycle_time_s,
+        "planner_fitted": blend_planner(tp, planner_fitted, planner).cycle_time_s,
     }
 
 
@@ -94,9 +94,9 @@ METHOD_COLUMNS = ("program", "set", "method", "measured_s", "predicted_s", "err_
 
 def method_rows(
     programs: dict[str, tuple[str, Toolpath, MoveData]],
-    machine: MachineProfile,
-    fir_fitted: FirSettings,
-    planner_fitted: MachineProfile,
+    profile: Profile,
+    fir_fitted: FirControl,
+    planner_fitted: Machine,
     bilstm: Trained,
     axis_nns: Sequence[Trained],
 ) -> pd.DataFrame:
@@ -106,6 +106,13 @@ def method_rows(
     ----------
     programs : dict
         Name -> (set, parsed program, its :class:`MoveData` with ``measured_s``).
+    profile : Profile
+        The recorded machine's profile (``linuxcnc_sim``).
+    fir_fitted : FirControl
+        The FIR kernel fitted to the training recordings (:func:`nctwin.identify.fit_fir`).
+    planner_fitted : Machine
+        The machine with the axis limits fitted to them (:func:`nctwin.identify.fit_planner`).
+    bilstm, axis_nns : trained networks
 
     Returns
     -------
@@ -115,7 +122,7 @@ def method_rows(
     """
     rows = []
     for name, (group, tp, data) in programs.items():
-        times = analytic_times(tp, machine, fir_fitted, planner_fitted)
+        times = analytic_times(tp, profile, fir_fitted, planner_fitted)
         times["bilstm"] = predict_bilstm(bilstm, data)
         times["axis_nn"] = predict_axis_nn(axis_nns, data)
         for method, t in times.items():
@@ -126,8 +133,9 @@ def method_rows(
     return pd.DataFrame(rows, columns=list(METHOD_COLUMNS))
 
 
-def path_control(tp: Toolpath, machine: MachineProfile) -> str:
-    """The path-control modes a program's moves run in, LinuxCNC's rules, as G-code.
+def path_control(tp: Toolpath, profile: Profile) -> str:
+    """The path-control modes a program's moves run in, LinuxCNC's rules (the tolerance where
+    the program sets none: the profile's ``[control.planner]``), as G-code.
 
     ``G61`` (exact path), ``G61.1`` (exact stop), ``G64`` (no tolerance), ``G64 P Q0`` (a
     tolerance, no naive-CAM merging) or ``G64 P Q>0`` (a tolerance, merging within Q; a
@@ -135,7 +143,7 @@ def path_control(tp: Toolpath, machine: MachineProfile) -> str:
     program.
     """
     moving = tp.kind != MotionKind.DWELL
-    tol = tp.effective_tolerance_mm(machine.blend_tol_mm)[moving]
+    tol = tp.effective_tolerance_mm(profile.control("planner").blend_tol_mm)[moving]
     naive = tp.effective_naive_tol_mm()[moving]
     mode = tp.path_mode[moving]
     label = np.where(
@@ -167,7 +175,7 @@ PLANNER_RULES = {
 
 
 def planner_ablation(
-    programs: dict[str, tuple[str, Toolpath, float]], machine: MachineProfile
+    programs: dict[str, tuple[str, Toolpath, float]], profile: Profile
 ) -> pd.DataFrame:
     """The blend-arc planner with and without its rules for blends at programmed arcs, for
     nearly tangent junctions, for the size of blend arcs and for stops on whole servo periods
@@ -190,9 +198,10 @@ def planner_ablation(
     """
     rows = []
     for name, (group, tp, measured) in programs.items():
-        mode = path_control(tp, machine)
+        mode = path_control(tp, profile)
         for rules, kwargs in PLANNER_RULES.items():
-            t = blend_planner(tp, machine, **kwargs).cycle_time_s
+            t = blend_planner(tp, profile.machine, profile.control("planner"), **kwargs)
+            t = t.cycle_time_s
             rows.append(
                 {"program": name, "set": group, "mode": mode, "rules": rules,
                  "measured_s": measured, "predicted_s": t,
@@ -201,7 +210,7 @@ def planner_ablation(
     return pd.DataFrame(rows)
 
 
-def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3) -> pd.DataFrame:
+def planner_block_gaps(rec: RecordedProgram, profile: Profile, n: int = 3) -> pd.DataFrame:
     """The ``n`` blocks of a recording of nctwin's own programs whose time the blend-arc planner
     misses most: block, kind, length (mm), programmed feed (mm/s), recorded and planned time
     (s), sorted by block."""
@@ -213,7 +222,7 @@ def planner_block_gaps(rec: RecordedProgram, machine: MachineProfile, n: int = 3
             "whose text is shipped)"
         )
     tp = parse(rec.program)
-    planned = blend_planner(tp, machine).block_times_s
+    planned = blend_planner(tp, profile.machine, profile.control("planner")).block_times_s
     measured = rec.targets.time_s
     worst = np.sort(np.argsort(-np.abs(planned - measured), kind="stable")[:n])
     return pd.DataFrame(
@@ -239,14 +248,8 @@ def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) ->
 # The chapter's inputs and claims
 
 
-#: The grid of the FIR kernel's settings searched by :func:`nctwin.identify.fit_fir`.
-FIR_GRID = {"fir_t1_s": [0.03, 0.045, 0.06, 0.09], "fir_t2_s": [0.003, 0.01],
-            "fir_acc_scale": [2.0, 4.0, 8.0], "fir_blend_ratio": [float("inf"), 0.25],
-            "fir_block_periods": [0, 2]}  # fmt: skip
-
-
 def evaluation_programs(
-    recordings: dict[str, RecordedProgram], machine: MachineProfile
+    recordings: dict[str, RecordedProgram], profile: Profile
 ) -> tuple[dict[str, tuple[str, Toolpath, MoveData]], list[str]]:
     """The programs the methods are scored on: the recorded test paths, the programs in the
     whole language (:mod:`nctwin.programs.language`) and the public programs whose text lies
@@ -256,8 +259,8 @@ def evaluation_programs(
     ----------
     recordings : dict
         Every shipped recording by name (:func:`nctwin.recordings.load_recordings`).
-    machine : MachineProfile
-        The recorded machine (``linuxcnc_sim``).
+    profile : Profile
+        The recorded machine's profile (``linuxcnc_sim``).
 
     Returns
     -------
@@ -271,10 +274,12 @@ def evaluation_programs(
         Recordings of public programs whose text is not beside the clone (their rows are
         skipped).
     """
+    machine, planner = profile.machine, profile.control("planner")
     programs = {}
     for name, rec in recordings.items():
         if name.startswith("test_"):
-            programs[name] = ("test paths", parse(rec.program), recorded_move_data(rec, machine))
+            data = recorded_move_data(rec, machine, planner)
+            programs[name] = ("test paths", parse(rec.program), data)
             continue
         if name.startswith("lang_"):
             group, text = "language", rec.program
@@ -284,7 +289,7 @@ def evaluation_programs(
             continue
         if text is not None:  # scored on the cycle time alone (arcs give no per-move targets)
             tp = parse(text)
-            data = move_data(rec.name, tp, machine)
+            data = move_data(rec.name, tp, machine, planner)
             data = dataclasses.replace(data, measured_s=rec.cycle_time_s)
             programs[name] = (group, tp, data)
     public_absent = [n for n, r in recordings.items() if r.source != "nctwin"

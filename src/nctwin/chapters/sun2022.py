@@ -25,12 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..estimate import estimate
-from ..estimate.kernel import fir_settings
+from ..estimate.cam import cam
 from ..gcode import parse
 from ..kernel import fir
 from ..learn.train import TrainConfig, Trained, fit
-from ..machine import MachineProfile
+from ..machine import Profile
 from ..methods import sun2022 as sun
 from ..motion import Motion
 from ..physics.measure import ControllerSamples, controller_samples, nearest_sample
@@ -135,14 +134,15 @@ class PocketRun:
 def run_pocket(
     text: str,
     number: int,
-    machine: MachineProfile,
+    profile: Profile,
     seed: int = 0,
     *,
     start: tuple[float, float, float] = (0.0, 0.0, 0.0),
     rate_hz: float = 5.0,
     jitter_s: float = 0.03,
 ) -> PocketRun:
-    """Run one pocket program from ``start`` (mm) on the FIR kernel and record it.
+    """Run one pocket program from ``start`` (mm) on the FIR kernel (the profile's machine and
+    ``[control.fir]``) and record it.
 
     Every cutter location is paired with the record nearest to it in space among those within
     2 s of the tool's passage (the paper's target). A rapid's cutter location is where the tool
@@ -154,7 +154,8 @@ def run_pocket(
     """
     parsed = parse(text, start_mm=start, source=f"pocket {number}")
     tp = parsed.take(parsed.lengths_mm > 0)
-    motion = fir.run(tp, machine, fir_settings(machine))
+    machine = profile.machine
+    motion = fir.run(tp, machine, profile.control("fir"))
     junction = block_targets(motion, tp).junction_sample
     passage = junction[1:]
     dt = np.diff(junction)[:, None] * motion.period_s
@@ -174,25 +175,25 @@ def run_pocket(
         measured_feed_mm_s=records.vel_mm_s[nearest],
         true_feed_mm_s=block_avg,
         commanded_mm_s=commanded,
-        cam_s=estimate(tp, machine, "cam").cycle_time_s,
+        cam_s=cam(tp, machine).cycle_time_s,
     )
 
 
 def run_pockets(
-    machine: MachineProfile, *, seed: int = 0, n_jobs: int = 1, **kwargs
+    profile: Profile, *, seed: int = 0, n_jobs: int = 1, **kwargs
 ) -> dict[int, PocketRun]:
     """All eight pockets, in parallel (``n_jobs``), each from its :func:`start_mm`; each pocket's
     record jitter is seeded with ``seed + number``. ``kwargs`` go to :func:`run_pocket`."""
     tasks = (
-        (pocket_program(spec), spec.number, machine, seed + spec.number, start_mm(spec))
+        (pocket_program(spec), spec.number, profile, seed + spec.number, start_mm(spec))
         for spec in POCKETS
     )
     runs = run_tasks(functools.partial(_run_pocket_from, **kwargs), tasks, n_jobs=n_jobs)
     return {r.number: r for r in runs}
 
 
-def _run_pocket_from(text, number, machine, seed, start, **kwargs) -> PocketRun:
-    return run_pocket(text, number, machine, seed, start=start, **kwargs)
+def _run_pocket_from(text, number, profile, seed, start, **kwargs) -> PocketRun:
+    return run_pocket(text, number, profile, seed, start=start, **kwargs)
 
 
 def part_stats(

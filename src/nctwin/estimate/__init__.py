@@ -1,10 +1,13 @@
 """Cycle-time estimators: analytic ones, simulation on a virtual NC kernel, and networks trained
 on a real control's recordings.
 
-Each method is a function ``f(toolpath, machine) -> Estimate``; :data:`METHODS` maps the names
-the CLI accepts to them. ``bilstm`` and ``axis_nn`` are the networks of the chapter "Predicting a
-real controller" (:mod:`nctwin.estimate.learned`); they exist only for a machine with shipped
-recordings (``linuxcnc_sim``), and train once on first use.
+Each method runs a tool path on a machine profile's :class:`~nctwin.machine.Machine` and one of
+its controls (:data:`nctwin.machine.METHOD_CONTROLS` says which): ``cam`` on the machine alone,
+``kernel`` on ``[control.fir]``, ``block_overlap`` on ``[control.accdec]``, ``planner`` on
+``[control.planner]``. ``bilstm`` and ``axis_nn`` are the networks of the chapter "Predicting a
+real controller" (:mod:`nctwin.estimate.learned`); they exist only for a profile that names
+shipped recordings (``linuxcnc_sim``), and train once on first use. :func:`estimate` picks the
+control from the profile; a profile that lacks it is refused in one line.
 """
 
 from __future__ import annotations
@@ -13,9 +16,7 @@ from collections.abc import Callable
 
 import pandas as pd
 
-from ..machine import MachineProfile
-from ..paths import results_dir
-from ..recordings import MACHINE as RECORDED_MACHINE
+from ..machine import Profile
 from ..toolpath import Toolpath
 from .blend_planner import blend_planner
 from .block_overlap import block_overlap
@@ -28,68 +29,77 @@ __all__ = [
     "Estimate",
     "best_method",
     "cam",
-    "default_method",
     "estimate",
     "kernel",
 ]
 
 
-def _bilstm(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+def _cam(toolpath: Toolpath, profile: Profile) -> Estimate:
+    return cam(toolpath, profile.machine)
+
+
+def _kernel(toolpath: Toolpath, profile: Profile) -> Estimate:
+    return kernel(toolpath, profile.machine, profile.control_for("kernel"))
+
+
+def _block_overlap(toolpath: Toolpath, profile: Profile) -> Estimate:
+    return block_overlap(toolpath, profile.machine, profile.control_for("block_overlap"))
+
+
+def _planner(toolpath: Toolpath, profile: Profile) -> Estimate:
+    return blend_planner(toolpath, profile.machine, profile.control_for("planner"))
+
+
+def _bilstm(toolpath: Toolpath, profile: Profile) -> Estimate:
     """:func:`nctwin.estimate.learned.bilstm`, imported on first use (torch takes seconds to
     import, and the other methods do not need it)."""
     from .learned import bilstm
 
-    return bilstm(toolpath, machine)
+    return bilstm(toolpath, profile)
 
 
-def _axis_nn(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+def _axis_nn(toolpath: Toolpath, profile: Profile) -> Estimate:
     """:func:`nctwin.estimate.learned.axis_nn`, imported on first use."""
     from .learned import axis_nn
 
-    return axis_nn(toolpath, machine)
+    return axis_nn(toolpath, profile)
 
 
-#: Estimators by name.
-METHODS: dict[str, Callable[[Toolpath, MachineProfile], Estimate]] = {
-    "cam": cam,
-    "kernel": kernel,
-    "block_overlap": block_overlap,
-    "planner": blend_planner,
+#: Estimators by name, each run on a profile (its machine and the control the method needs).
+METHODS: dict[str, Callable[[Toolpath, Profile], Estimate]] = {
+    "cam": _cam,
+    "kernel": _kernel,
+    "block_overlap": _block_overlap,
+    "planner": _planner,
     "bilstm": _bilstm,
     "axis_nn": _axis_nn,
 }
 
 
-def estimate(toolpath: Toolpath, machine: MachineProfile, method: str = "cam") -> Estimate:
-    """Estimate the cycle time of ``toolpath`` on ``machine`` with the named method."""
+def estimate(toolpath: Toolpath, profile: Profile, method: str | None = None) -> Estimate:
+    """Estimate the cycle time of ``toolpath`` on ``profile`` with the named method (default
+    the profile's ``default_method``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, or a profile without the control the method needs.
+    """
+    method = profile.default_method if method is None else method
     try:
         fn = METHODS[method]
     except KeyError:
         raise ValueError(f"method = {method!r} is unknown: allowed {', '.join(METHODS)}") from None
-    return fn(toolpath, machine)
+    profile.control_for(method)  # refuses a profile without the method's control first
+    return fn(toolpath, profile)
 
 
 def best_method(summary: pd.DataFrame) -> str:
     """The method with the lowest median error on the public programs (on the test paths where
-    no public program was run): the default of ``nctwin estimate`` for the recorded machine."""
+    no public program was run): what a chapter that compares methods on a machine's recordings
+    recommends as its profile's ``default_method``."""
     group = "public" if (summary.set == "public").any() else "test paths"
     rows = summary[summary.set == group].sort_values(
         ["median_abs_err_pct", "worst_abs_err_pct"], kind="stable"
     )
     return str(rows.method.iloc[0])
-
-
-#: Where the methods were compared on a machine that only recordings know: profile name -> the
-#: summary a chapter wrote (``results/<stem>/<table>.csv``, see :func:`best_method`).
-COMPARED = {RECORDED_MACHINE: ("linuxcnc_real_kernel", "summary")}
-
-
-def default_method(machine: MachineProfile) -> str:
-    """The method ``nctwin estimate`` uses when none is named: for a machine of
-    :data:`COMPARED`, the best one its chapter found (:func:`best_method` of the chapter's
-    summary, where it has been written); ``cam`` for the others."""
-    if machine.name not in COMPARED:
-        return "cam"
-    stem, table = COMPARED[machine.name]
-    path = results_dir() / stem / f"{table}.csv"
-    return best_method(pd.read_csv(path)) if path.is_file() else "cam"

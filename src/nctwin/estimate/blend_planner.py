@@ -131,7 +131,9 @@ import math
 
 import numpy as np
 
-from ..machine import MachineProfile
+from ..controls import PlannerControl
+from ..limits import path_limits
+from ..machine import Machine
 from ..naivecam import merge_naive_cam
 from ..toolpath import MotionKind, PathMode, Toolpath
 from .blend_junctions import (
@@ -173,15 +175,16 @@ STOP_PERIODS = ("whole", "mean", "off")
 
 
 def move_limits(
-    moves: Toolpath, machine: MachineProfile, acc_scale: np.ndarray | None = None
+    moves: Toolpath, machine: Machine, acc_scale: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Feed and tangential acceleration of each move as LinuxCNC plans it, shapes (M,).
 
     Lines and rapids: the feed (the rapid feed for rapids) within the control's maximum and
     the axes' velocities, :math:`\min_i v_{i,\max} / |u_i|`, and the path acceleration the
-    axes allow, :math:`\min_i a_{i,\max} / |u_i|` (canon's ``getStraightAcceleration``).
-    Arcs: the same with the plane's two axes taking the planar share of the length and the
-    third the helical share; then the centripetal limit of ``pmCircleActualMaxVel``: the speed
+    axes allow, :math:`\min_i a_{i,\max} / |u_i|` (canon's ``getStraightAcceleration``;
+    :func:`nctwin.limits.path_limits`, whose rule for arcs is LinuxCNC's: the plane's two axes
+    take the planar share of the length and the third the helical share); on arcs then the
+    centripetal limit of ``pmCircleActualMaxVel``: the speed
     stays within :math:`\sqrt{a_n r}` with :math:`a_n` = :data:`NORMAL_ACC_RATIO` :math:`a`,
     and the tangential acceleration is :math:`a/2` where that limit binds, else
     :math:`a \sqrt{1 - (F^2 / (r a))^2}`.
@@ -190,12 +193,13 @@ def move_limits(
     ----------
     moves : Toolpath
         M moves of non-zero length (no dwells).
-    machine : MachineProfile
+    machine : Machine
     acc_scale : ndarray, shape (M,), optional
         Share of the acceleration each move may use (LinuxCNC halves it on both moves of a
         parabolic blend, ``tcGetOverallMaxAccel``); 1 by default.
     """
-    v_axes, acc = path_limits(moves, machine)
+    limits = path_limits(moves, machine)
+    v_axes, acc = limits.velocity_mm_s, limits.acceleration_mm_s2
     if acc_scale is not None:
         acc = acc * acc_scale
     rapid = moves.kind == MotionKind.RAPID
@@ -210,29 +214,6 @@ def move_limits(
         ratio = np.sqrt(np.maximum(1.0 - (a_normal / a) ** 2, 0.0))
         acc[arc] = a * np.where(cut, TANGENTIAL_ACC_RATIO, ratio)
     return feed, acc
-
-
-def path_limits(moves: Toolpath, machine: MachineProfile) -> tuple[np.ndarray, np.ndarray]:
-    r"""Velocity and acceleration the axes allow along each move, shapes (M,):
-    :math:`\min_i v_{i,\max} / |u_i|` and :math:`\min_i a_{i,\max} / |u_i|` with :math:`u`
-    the move's direction, an arc's plane axes taking its planar share and the third its helical
-    share (canon's ``getStraightVelocity``, ``getStraightAcceleration``; LinuxCNC's
-    ``maxaccel`` of a move)."""
-    vmax = np.asarray(machine.axis_max_velocity_mm_s)
-    amax = np.asarray(machine.axis_max_acceleration_mm_s2)
-    share = np.abs(moves.directions)  # of each axis in the move's length
-    arc = np.flatnonzero(moves.is_arc)
-    if len(arc):
-        ax = moves._plane_axes[arc]
-        rows = np.arange(len(arc))
-        planar = moves.radius_mm[arc] * np.abs(moves.sweep_rad[arc]) / moves.lengths_mm[arc]
-        s = np.empty((len(arc), 3))
-        s[rows, ax[:, 0]] = planar
-        s[rows, ax[:, 1]] = planar
-        s[rows, ax[:, 2]] = np.sqrt(np.maximum(1.0 - planar**2, 0.0))
-        share[arc] = s
-    with np.errstate(divide="ignore"):
-        return np.min(vmax / share, axis=1), np.min(amax / share, axis=1)
 
 
 def junction_blends(
@@ -421,7 +402,8 @@ def parabolic_blend_speeds(
 
 def blend_planner(
     toolpath: Toolpath,
-    machine: MachineProfile,
+    machine: Machine,
+    control: PlannerControl,
     *,
     kinks: bool = True,
     sized_arcs: bool = True,
@@ -435,8 +417,10 @@ def blend_planner(
     ----------
     toolpath : Toolpath
         N blocks (arcs are taken as chords).
-    machine : MachineProfile
-        Axis velocity and acceleration limits, maximum and rapid feed, period, tolerance.
+    machine : Machine
+        Axis velocity and acceleration limits, maximum and rapid feed.
+    control : PlannerControl
+        Servo period and the tolerance where the program sets none.
     kinks, sized_arcs : bool
         LinuxCNC's rules for nearly tangent junctions and G61's reduced acceleration
         (:func:`tangent_junctions`), and for the size of blend arcs (:func:`junction_blends`);
@@ -471,7 +455,7 @@ def blend_planner(
     moves = merged.take(source)
     length = moves.lengths_mm
     feed, acc = move_limits(moves, machine)
-    tol = moves.effective_tolerance_mm(machine.blend_tol_mm)
+    tol = moves.effective_tolerance_mm(control.blend_tol_mm)
     # a dwell between two moves stops the tool; the move before it keeps its parabolic end
     after = np.searchsorted(source, np.flatnonzero(merged.kind == MotionKind.DWELL))
     parabolic_end = np.zeros(len(moves), bool)
@@ -487,7 +471,7 @@ def blend_planner(
     # at 1 - k of their acceleration; the other G61 junctions stop with both moves at
     # 1 - KINK_RATIO (tcSetKinkProperties, kept where no blend arc replaces the kink)
     stop = (tol[1:] == 0) & (moves.path_mode[:-1] != PathMode.EXACT_PATH)
-    tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, machine.period_s)
+    tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, control.period_s)
     tangent &= ~stop & kinks
     exact = (tol[1:] == 0) & ~stop & ~tangent & kinks
     # a junction with an arc: a blend arc as LinuxCNC makes it, if it beats a tangent pass at
@@ -496,8 +480,8 @@ def blend_planner(
     candidates = parabolic_junctions(moves, tol, stop_turn_rad, in_plane=True) & ~tangent
     if not (arc_blends and kinks):
         candidates[:] = False
-    speed = np.minimum(feed, length / machine.period_s)
-    path_acc = path_limits(moves, machine)[1]
+    speed = np.minimum(feed, length / control.period_s)
+    path_acc = path_limits(moves, machine).acceleration_mm_s2
     axis_vel = np.asarray(machine.axis_max_velocity_mm_s)
     line_trim = np.zeros(len(moves))  # what the line-line blends take off the moves' starts
     if candidates.any():
@@ -507,7 +491,7 @@ def blend_planner(
         )[1]  # fmt: skip
     choice = arc_junctions(
         moves, candidates, speed, path_acc, tol[1:], kink, line_trim, axis_acc, axis_vel,
-        machine.period_s,
+        control.period_s,
     )  # fmt: skip
     kinked = choice["choice"] == TANGENT_BLEND
     reduce = np.where(tangent, kink, np.where(exact | kinked, KINK_RATIO, 0.0))
@@ -562,7 +546,7 @@ def blend_planner(
     # a line remainder the next arc passes in under GAP_CYCLES periods becomes part of it
     rem = item_len[0:-1:2]
     with np.errstate(divide="ignore", invalid="ignore"):
-        eat = (arc > 0) & (rem < GAP_CYCLES * machine.period_s * v) & ~moves.is_arc[:-1]
+        eat = (arc > 0) & (rem < GAP_CYCLES * control.period_s * v) & ~moves.is_arc[:-1]
     item_len[1::2] += np.where(eat, rem, 0.0)
     item_len[0:-1:2] = np.where(eat, 0.0, rem)
     item_acc = np.empty(2 * m - 1)
@@ -579,7 +563,7 @@ def blend_planner(
     limit = np.full(len(keep), np.inf)
     np.minimum.at(limit, at[at >= 0], end_limit[at >= 0])
     q_len, q_acc = item_len[keep], item_acc[keep]
-    cap = q_len / (MIN_SEGMENT_CYCLES * machine.period_s)
+    cap = q_len / (MIN_SEGMENT_CYCLES * control.period_s)
     q_feed = np.minimum(item_feed[keep], cap)
     # the look-ahead plans with the speed limits of the machine, not the programmed feed
     item_max = np.empty(2 * m - 1)
@@ -600,16 +584,16 @@ def blend_planner(
         np.searchsorted(keep, 2 * queued - 1, side="right") - 1,
         new_len,
         TANGENTIAL_ACC_RATIO * acc[1:],
-        np.minimum(feed[1:], length[1:] / (MIN_SEGMENT_CYCLES * machine.period_s)),
+        np.minimum(feed[1:], length[1:] / (MIN_SEGMENT_CYCLES * control.period_s)),
     )
     limit = np.minimum(limit, np.where(blended, end, 0.0))
     limit = np.minimum(limit[:-1], np.minimum(q_feed[:-1], q_feed[1:]))
     t = np.zeros(2 * m - 1)
     t[keep] = segment_times(q_len, q_feed, q_acc, limit)
     if stop_periods == "whole":
-        t[keep] = stops_on_periods(t[keep], limit, machine.period_s)
+        t[keep] = stops_on_periods(t[keep], limit, control.period_s)
     elif stop_periods == "mean":
-        t[keep] += np.append(limit == 0, True) * (0.5 * machine.period_s)
+        t[keep] += np.append(limit == 0, True) * (0.5 * control.period_s)
     move_t = t[0::2] + np.concatenate([[0.0], t[1::2] / 2]) + np.concatenate([t[1::2] / 2, [0.0]])
     block_t = np.bincount(merged_source[source], weights=move_t, minlength=len(toolpath))
     block_t += toolpath.dwell_s

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..machine import MachineProfile
+from ..controls import AccDecControl
+from ..machine import Machine
 from ..methods import lee2022
 from ..toolpath import Toolpath
 from .result import Estimate
@@ -15,16 +16,22 @@ __all__ = ["block_overlap"]
 
 def block_overlap(
     toolpath: Toolpath,
-    machine: MachineProfile,
+    machine: Machine,
+    control: AccDecControl,
     *,
     overlap: bool = True,
     inposition: bool = True,
     inposition_s: tuple[float, float, float] | np.ndarray | None = None,
 ) -> Estimate:
     """``method="block_overlap"``: :func:`nctwin.methods.lee2022.overlapped_block_times` of
-    ``toolpath`` on ``machine`` (the keywords are its ablations), per-block times of shape
-    (N,)."""
+    ``toolpath`` on ``machine`` with the acc/dec ``control`` (the keywords are its ablations),
+    per-block times of shape (N,), named after ``machine``."""
     times = lee2022.overlapped_block_times(
-        toolpath, machine, overlap=overlap, inposition=inposition, inposition_s=inposition_s
+        toolpath,
+        machine,
+        control,
+        overlap=overlap,
+        inposition=inposition,
+        inposition_s=inposition_s,
     )
     return Estimate("block_overlap", machine.name, times, toolpath)

@@ -17,20 +17,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..machine import MachineProfile
+from ..machine import Machine
 from ..toolpath import MotionKind, Toolpath
 from .result import Estimate
 
 __all__ = ["cam"]
 
 
-def cam(toolpath: Toolpath, machine: MachineProfile) -> Estimate:
+def cam(toolpath: Toolpath, machine: Machine) -> Estimate:
     """CAD/CAM cycle time: each block at its programmed feed (or the rapid feed), no dynamics.
 
     Parameters
     ----------
     toolpath : Toolpath
-    machine : MachineProfile
+    machine : Machine
         Supplies the rapid feed and the maximum feed.
 
     Returns

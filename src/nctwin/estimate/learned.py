@@ -36,12 +36,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..controls import PlannerControl
 from ..gcode import parse
 from ..geometry import PathGeometry
 from ..learn.train import TrainConfig, Trained, fit
-from ..machine import MachineProfile
+from ..machine import Machine, Profile
 from ..methods import chien2023, sun2022
-from ..recordings import MACHINE as RECORDED_MACHINE
+from ..recordings import NAME as RECORDINGS
 from ..recordings import RecordedProgram, load_recordings
 from ..targets import BlockTargets
 from ..toolpath import MotionKind, Toolpath
@@ -139,20 +140,21 @@ def model_blocks(tp: Toolpath) -> tuple[Toolpath, np.ndarray]:
     return moves, source
 
 
-def features(moves: Toolpath, machine: MachineProfile) -> np.ndarray:
-    r"""Features of each move, shape (M, 6), columns :data:`FEATURES`.
+def features(moves: Toolpath, machine: Machine, control: PlannerControl) -> np.ndarray:
+    r"""Features of each move, shape (M, 7), columns :data:`FEATURES`.
 
     Chien et al. (2023, Sec. 2.2) :math:`(F, l_k, \theta_k, \theta_{k+1}, \varepsilon)` with
-    LinuxCNC's rules for the feed and tolerance (see the module docstring), and the path
-    acceleration :math:`a_k` the axes allow along the move. The tool starts and ends at rest
-    (corner angle :math:`\pi`).
+    LinuxCNC's rules for the feed and tolerance (see the module docstring; the tolerance where
+    the program sets none is ``control``'s), the path acceleration :math:`a_k` the axes allow
+    along the move (:func:`nctwin.limits.path_limits`) and the naive-CAM tolerance. The tool
+    starts and ends at rest (corner angle :math:`\pi`).
     """
     feed, acc = move_limits(moves, machine)
     n = len(moves)
     theta = np.append(moves.corner_angles_rad, np.pi)
     if n:
         theta[0] = np.pi
-    tol = moves.effective_tolerance_mm(machine.blend_tol_mm)
+    tol = moves.effective_tolerance_mm(control.blend_tol_mm)
     naive = moves.effective_naive_tol_mm()
     return np.column_stack(
         [feed, moves.lengths_mm, theta[:n], theta[1:], np.minimum(tol, TOL_CAP_MM), acc, naive]
@@ -194,7 +196,11 @@ class MoveData:
 
 
 def move_data(
-    name: str, tp: Toolpath, machine: MachineProfile, targets: BlockTargets | None = None
+    name: str,
+    tp: Toolpath,
+    machine: Machine,
+    control: PlannerControl,
+    targets: BlockTargets | None = None,
 ) -> MoveData:
     """Features (and, from a recording's per-block ``targets``, targets) of a program.
 
@@ -202,7 +208,7 @@ def move_data(
     targets are NaN and ``measured_s`` is NaN.
     """
     moves, source = model_blocks(tp)
-    x = features(moves, machine)
+    x = features(moves, machine, control)
     feed, length = x[:, 0], x[:, 1]
     clipped = dataclasses.replace(moves, feed_mm_s=feed)
     ax = sun2022.features(clipped, machine.rapid_feed_mm_s)
@@ -232,9 +238,9 @@ def move_data(
     )
 
 
-def recorded_move_data(rec: RecordedProgram, machine: MachineProfile) -> MoveData:
+def recorded_move_data(rec: RecordedProgram, machine: Machine, control: PlannerControl) -> MoveData:
     """:func:`move_data` of a shipped recording of one of nctwin's programs."""
-    return move_data(rec.name, parse(rec.program), machine, rec.targets)
+    return move_data(rec.name, parse(rec.program), machine, control, rec.targets)
 
 
 #: Second output of the BiLSTM: the log time ratio (the chapter's), or the ratio itself (the
@@ -329,10 +335,9 @@ def train_configs(seed: int = 0, scale: float = 1.0) -> tuple[TrainConfig, Train
     return bilstm, axis
 
 
-def training_data(
-    machine: MachineProfile, sets: Sequence[str] = ("train", "broad")
-) -> list[MoveData]:
-    """The recordings of ``machine`` of the training ``sets`` as :class:`MoveData`.
+def training_data(profile: Profile, sets: Sequence[str] = ("train", "broad")) -> list[MoveData]:
+    """The recordings of ``profile``'s machine of the training ``sets`` as :class:`MoveData`
+    (features on its machine and its ``[control.planner]``).
 
     ``sets`` picks among ``train`` (paper 1's programs), ``broad`` (the broad set) and ``cam``
     (the CAM-style set, :mod:`nctwin.programs.camstyle`); the chapter's methods learn from the
@@ -341,30 +346,32 @@ def training_data(
     Raises
     ------
     ValueError
-        If ``machine`` is not the machine of the shipped recordings, or a set is unknown.
+        If the profile names no shipped recordings (its ``recordings`` key), or a set is
+        unknown.
     """
     unknown = set(sets) - set(TRAINING_SETS)
     if unknown:
         raise ValueError(
             f"sets = {tuple(sets)!r} is not allowed: allowed {', '.join(TRAINING_SETS)}"
         )
-    if machine.name != RECORDED_MACHINE:
+    if profile.recordings != RECORDINGS:
         raise ValueError(
-            f"machine = {machine.name!r} has no recordings to learn from: allowed "
-            f"{RECORDED_MACHINE!r} (the LinuxCNC recordings)"
+            f"recordings = {profile.recordings!r} of machine profile {profile.name} names no "
+            f"shipped recordings to learn from: allowed {RECORDINGS!r} (LinuxCNC's)"
         )
+    machine, control = profile.machine, profile.control("planner")
     recs = load_recordings()
     return [
-        recorded_move_data(rec, machine)
+        recorded_move_data(rec, machine, control)
         for name, rec in recs.items()
         if name.startswith(tuple(f"{s}_" for s in sets))
     ]
 
 
-def trained_models(machine: MachineProfile, seed: int = 0) -> tuple[Trained, list[Trained]]:
-    """The chapter's BiLSTM and per-axis networks for ``machine`` (trained once, then loaded
-    from ``data/cache/models``)."""
-    data = training_data(machine)
+def trained_models(profile: Profile, seed: int = 0) -> tuple[Trained, list[Trained]]:
+    """The chapter's BiLSTM and per-axis networks for ``profile`` (trained once, then loaded
+    from the cache's ``models``)."""
+    data = training_data(profile)
     bilstm_cfg, axis_cfg = train_configs(seed)
     return train_bilstm(data, bilstm_cfg), train_axis_nns(data, axis_cfg)
 
@@ -378,7 +385,7 @@ def move_floors_s(data: MoveData) -> np.ndarray:
 
 
 def _floored_estimate(
-    tp: Toolpath, data: MoveData, move_times_s: np.ndarray, method: str, machine: MachineProfile
+    tp: Toolpath, data: MoveData, move_times_s: np.ndarray, method: str, machine: Machine
 ) -> Estimate:
     """Per-block :class:`~nctwin.estimate.result.Estimate` from per-move predictions, each
     raised to its physical floor (:func:`move_floors_s`); dwells keep their time."""
@@ -398,17 +405,19 @@ def _floored_estimate(
     )
 
 
-def bilstm(tp: Toolpath, machine: MachineProfile) -> Estimate:
-    """``nctwin estimate --method bilstm``: the chapter's BiLSTM (LinuxCNC recordings only),
-    every move at least its physical floor (:func:`move_floors_s`)."""
-    model, _ = trained_models(machine)
-    data = move_data("program", tp, machine)
-    return _floored_estimate(tp, data, bilstm_move_times(model, data), "bilstm", machine)
+def bilstm(tp: Toolpath, profile: Profile) -> Estimate:
+    """``nctwin estimate --method bilstm``: the chapter's BiLSTM (a profile with the LinuxCNC
+    recordings only), every move at least its physical floor (:func:`move_floors_s`)."""
+    model, _ = trained_models(profile)
+    data = move_data("program", tp, profile.machine, profile.control("planner"))
+    return _floored_estimate(tp, data, bilstm_move_times(model, data), "bilstm", profile.machine)
 
 
-def axis_nn(tp: Toolpath, machine: MachineProfile) -> Estimate:
-    """``nctwin estimate --method axis_nn``: the chapter's per-axis networks (LinuxCNC only),
-    every move at least its physical floor (:func:`move_floors_s`)."""
-    _, models = trained_models(machine)
-    data = move_data("program", tp, machine)
-    return _floored_estimate(tp, data, axis_nn_move_times(models, data), "axis_nn", machine)
+def axis_nn(tp: Toolpath, profile: Profile) -> Estimate:
+    """``nctwin estimate --method axis_nn``: the chapter's per-axis networks (a profile with
+    the LinuxCNC recordings only), every move at least its physical floor
+    (:func:`move_floors_s`)."""
+    _, models = trained_models(profile)
+    data = move_data("program", tp, profile.machine, profile.control("planner"))
+    models_times = axis_nn_move_times(models, data)
+    return _floored_estimate(tp, data, models_times, "axis_nn", profile.machine)

@@ -11,10 +11,12 @@ What is simulated
 -----------------
 Interpolation (ZOH at :math:`T_I`)
     A *chain* of consecutive cutting blocks (G1, G2, G3) is interpolated back to back along its
-    arc length at each block's feed :math:`F_k` (clamped to ``max_feed_mm_s``). A block may end
-    inside an interpolation period; the rest of that period already moves along the next block,
-    so the interpolator rounds the chain, not each block, up to a whole number of periods. (The
-    estimator rounds every block up, eq. 2; this is one source of its error.)
+    arc length at each block's feed :math:`F_k` (clamped to the machine's ``max_feed_mm_s`` and
+    to what its axis velocities allow along the block, :func:`nctwin.limits.path_limits`; the
+    estimator has no such clamp). A block may end inside an interpolation period; the rest of
+    that period already moves along the next block, so the interpolator rounds the chain, not
+    each block, up to a whole number of periods. (The estimator rounds every block up, eq. 2;
+    this is one source of its error.)
 Acc/dec after interpolation (linear type)
     Each axis's per-period displacement passes through a moving average of length
     :math:`A_T` (``cut_time_constant_s``). The filter is the continuous-time box filter
@@ -43,6 +45,14 @@ Position loop and in-position check
 Dwell (G4)
     The command stands still for :math:`\lceil t_\mathrm{dwell} \rceil_{T_I}`.
 
+Settings
+--------
+The control's settings (:math:`T_I`, the time constants, the rapid type, the position loops and
+in-position widths) are an :class:`nctwin.controls.AccDecControl` (a profile's
+``[control.accdec]`` table); the :class:`~nctwin.machine.Machine` gives the rapid feed
+:math:`F_r`, the maximum feed and the axis velocities. Accelerations are the control's, set by
+its time constants, so the machine's acceleration and jerk limits are not read.
+
 Conventions
 -----------
 Samples at ``t = i * period_s``; sample 0 is the start position. The velocity stored at sample
@@ -61,7 +71,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from ..machine import MachineProfile, whole_periods
+from ..controls import AccDecControl
+from ..limits import path_limits
+from ..machine import Machine
 from ..motion import Motion
 from ..physics.servo import PositionLoop
 from ..toolpath import PLANE_AXES, MotionKind, Toolpath
@@ -204,32 +216,37 @@ def _chain_path(geo: _Geometry, blocks: np.ndarray, feed: np.ndarray, period_s: 
     return np.diff(pos, axis=0), blocks[local[1:]]
 
 
-def _rapid_axis_profile(d_mm: float, machine: MachineProfile, k_r: int, k_s: int) -> np.ndarray:
-    """Displacement per period of one straight rapid of signed travel ``d_mm`` (eq. 6-16),
-    before the bell stage; shape (m,)."""
-    ti, fr = machine.period_s, machine.rapid_feed_mm_s
+def _rapid_axis_profile(
+    d_mm: float, rapid_feed_mm_s: float, control: AccDecControl, k_r: int
+) -> np.ndarray:
+    """Displacement per period of one straight rapid of signed travel ``d_mm`` at the rapid
+    feed (eq. 6-16), before the bell stage; shape (m,)."""
+    ti, fr = control.period_s, rapid_feed_mm_s
     length = abs(d_mm)
     if length == 0.0:
         return np.zeros(0)
     m = int(_ceil_periods(length / fr, ti))
     k = k_r
     if m < k_r:  # short rapid: triangle at a = Fr / ATR (eq. 9-12)
-        a = fr / machine.rapid_time_constant_s
+        a = fr / control.rapid_time_constant_s
         m = k = max(int(_ceil_periods(math.sqrt(length / a), ti)), 1)
     return _box(np.full((m, 1), d_mm / m), k)[:, 0]
 
 
-def _rapid(tp: Toolpath, j: int, machine: MachineProfile, k_r: int, k_s: int) -> np.ndarray:
+def _rapid(
+    tp: Toolpath, j: int, machine: Machine, control: AccDecControl, k_r: int, k_s: int
+) -> np.ndarray:
     """Displacement per period of rapid block ``j`` after acc/dec and bell; shape (m, 3)."""
     d = tp.end_mm[j] - tp.start_mm[j]
-    if machine.rapid_type == "linear":
+    fr = machine.rapid_feed_mm_s
+    if control.rapid_type == "linear":
         length = float(np.linalg.norm(d))
         if length == 0.0:
             return np.zeros((0, 3))
-        prof = _rapid_axis_profile(length, machine, k_r, k_s)
+        prof = _rapid_axis_profile(length, fr, control, k_r)
         disp = prof[:, None] * (d / length)[None, :]
     else:  # non-linear: every axis at the rapid feed on its own (eq. 7, 12)
-        profs = [_rapid_axis_profile(float(x), machine, k_r, k_s) for x in d]
+        profs = [_rapid_axis_profile(float(x), fr, control, k_r) for x in d]
         m = max(len(p) for p in profs)
         disp = np.zeros((m, 3))
         for a, p in enumerate(profs):
@@ -251,18 +268,22 @@ def _segments(kind: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(starts.tolist(), stops.tolist(), strict=True))
 
 
-def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
-    """Run a program on the Fanuc-like control.
+def simulate(toolpath: Toolpath, machine: Machine, control: AccDecControl) -> AccDecRun:
+    """Run a program on the ideal block-overlap control.
 
     Parameters
     ----------
     toolpath : Toolpath
         N blocks; cutting blocks need a feed.
-    machine : MachineProfile
+    machine : Machine
+        Uses ``rapid_feed_mm_s`` (Fr), ``max_feed_mm_s`` and ``axis_max_velocity_mm_s`` (a
+        cutting block's feed is clamped to what the axes allow along it,
+        :func:`nctwin.limits.path_limits`). Its acceleration and jerk limits are not read: the
+        control accelerates as its time constants say, which a profile sets within them.
+    control : AccDecControl
         Uses ``period_s`` (TI), ``cut_time_constant_s`` (AT), ``rapid_time_constant_s`` (ATR),
-        ``rapid_bell_s`` (As), ``rapid_feed_mm_s`` (Fr), ``rapid_type``, ``max_feed_mm_s``,
-        ``position_gain_per_s`` (Kp) and ``inposition_width_mm``. The time constants must be
-        whole multiples of ``period_s``.
+        ``rapid_bell_s`` (As), ``rapid_type``, ``position_gain_per_s`` (Kp) and
+        ``inposition_width_mm``. The time constants must be whole multiples of ``period_s``.
 
     Returns
     -------
@@ -273,13 +294,14 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
     ValueError
         If a time constant is not a whole number of periods, or a cutting block has no feed.
     """
-    ti = machine.period_s
-    k_at = whole_periods("cut_time_constant_s", machine.cut_time_constant_s, ti)
-    k_r = whole_periods("rapid_time_constant_s", machine.rapid_time_constant_s, ti)
-    k_s = whole_periods("rapid_bell_s", machine.rapid_bell_s, ti)
+    ti = control.period_s
+    k_at = control.periods("cut_time_constant_s")
+    k_r = control.periods("rapid_time_constant_s")
+    k_s = control.periods("rapid_bell_s")
     kind = toolpath.kind
     cut = np.isin(kind, _CUT)
     feed = np.minimum(toolpath.feed_mm_s, machine.max_feed_mm_s)
+    feed = np.minimum(feed, path_limits(toolpath, machine).velocity_mm_s)
     bad = cut & ~(feed > 0) & (toolpath.lengths_mm > 0)
     if bad.any():
         j = int(np.flatnonzero(bad)[0])
@@ -287,10 +309,10 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
             f"feed_mm_s = {float(toolpath.feed_mm_s[j])!r} of block {j} "
             f"(line {toolpath.line[j]}) is out of range: a cutting block needs a feed F > 0"
         )
-    width = np.asarray(machine.inposition_width_mm)
+    width = np.asarray(control.inposition_width_mm)
     # each axis's position loop, exact for a velocity held over a period: e <- r e + g d, with
     # r = exp(-Kp TI) and g = bd / TI per mm of commanded displacement d in the period
-    loops = [PositionLoop("first_order_ff", kp) for kp in machine.position_gain_per_s]
+    loops = [PositionLoop("first_order_ff", kp) for kp in control.position_gain_per_s]
     ad, bd = zip(*(loop.matrices(ti) for loop in loops), strict=True)
     r = np.array([a[0, 0] for a in ad])
     g = np.array([b[0] for b in bd]) / ti
@@ -310,7 +332,7 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
             d = _box(d, k_at) if len(d) else d
             own = np.concatenate([own, np.full(len(d) - len(own), stop - 1, np.int64)])
         elif k0 == MotionKind.RAPID:
-            d = _rapid(toolpath, first, machine, k_r, k_s)
+            d = _rapid(toolpath, first, machine, control, k_r, k_s)
             own = np.full(len(d), first, np.int64)
         else:  # dwell
             d = np.zeros((int(_ceil_periods(toolpath.dwell_s[first], ti)), 3))
@@ -350,9 +372,10 @@ def simulate(toolpath: Toolpath, machine: MachineProfile) -> AccDecRun:
     return AccDecRun(motion, ferr, times, wait, cmd_end)
 
 
-def run(toolpath: Toolpath, machine: MachineProfile) -> Motion:
-    """Commanded motion of ``toolpath`` on the Fanuc-like control (see :func:`simulate`)."""
-    return simulate(toolpath, machine).motion
+def run(toolpath: Toolpath, machine: Machine, control: AccDecControl) -> Motion:
+    """Commanded motion of ``toolpath`` on the ideal block-overlap control (see
+    :func:`simulate`)."""
+    return simulate(toolpath, machine, control).motion
 
 
 @dataclass(frozen=True, eq=False)
@@ -376,7 +399,8 @@ class InPositionMeasurement:
 
 
 def measure_inposition_times(
-    machine: MachineProfile,
+    machine: Machine,
+    control: AccDecControl,
     *,
     repeats: int = 5,
     seed: int = 0,
@@ -389,6 +413,22 @@ def measure_inposition_times(
     the time from the end of the rapid's command until the axis is within its in-position width
     is recorded, and the mean is the compensation value (the paper: 5 repeats; X, Y 25 ms,
     Z 120 ms on its Fanuc 0i-MD testbed).
+
+    Parameters
+    ----------
+    machine : Machine
+    control : AccDecControl
+        The machine and control measured (see :func:`simulate`).
+    repeats : int
+        Rapids per axis, >= 1.
+    seed : int
+        Seed of the travels and their signs.
+    distance_mm : tuple of 2 floats
+        Range of the travels, ``0 < lo <= hi``.
+
+    Returns
+    -------
+    InPositionMeasurement
 
     Raises
     ------
@@ -408,7 +448,7 @@ def measure_inposition_times(
             end = np.zeros((1, 3))
             end[0, a] = dist[a, i]
             tp = _single_rapid(end)
-            samples[a, i] = simulate(tp, machine).inposition_wait_s[0]
+            samples[a, i] = simulate(tp, machine, control).inposition_wait_s[0]
     return InPositionMeasurement(samples.mean(axis=1), samples, dist)
 
 

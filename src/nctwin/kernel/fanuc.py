@@ -12,7 +12,8 @@ Interpolator (cutting feed: G1, G2, G3)
     Each block is distributed at its feed :math:`v_k` along the path, one period at a time
     (:math:`v_k T_I` of arc length per period, the rest in the block's last period); the next
     cutting block starts in the next period. :math:`v_k` is the programmed F, clamped by the
-    machine's maximum feed, by the *feedrate clamp by arc radius* on arcs
+    machine's maximum feed and by what its axis velocities allow along the block
+    (:func:`nctwin.limits.path_limits`), by the *feedrate clamp by arc radius* on arcs
     (:math:`v \le \sqrt{a_r R}`, Fanuc No. 1730/1731) and by the *block-processing time*
     :math:`t_b` (a block lasts at least :math:`t_b`: :math:`v \le l / t_b`).
 Acc/dec after interpolation (cutting feed)
@@ -50,9 +51,16 @@ In-position and exact stop
 Dwell (G4)
     The command stands still for the dwell, rounded up to whole periods.
 
+Settings
+--------
+Every setting of the control is a field of :class:`nctwin.controls.FanucControl` (a profile's
+``[control.fanuc]`` table). The :class:`~nctwin.machine.Machine` gives the rapid feed, the
+maximum feed and the axis velocities; accelerations are the control's, set by its time
+constants, so the machine's acceleration and jerk limits are not read.
+
 Conventions
 -----------
-Sample ``i`` is at ``t = i * interp_period_s``; sample 0 is the start at rest. The command and
+Sample ``i`` is at ``t = i * period_s``; sample 0 is the start at rest. The command and
 the measured position at sample ``i`` are those at the end of period ``i``; ``block[i]`` is the
 block the control executes in period ``i`` (a deceleration, an in-position wait or the tail of
 a filter is credited to the block that ends there). Velocities are backward differences of the
@@ -63,14 +71,14 @@ block) is not read by :func:`nctwin.gcode.parse`; write ``G61`` ... ``G64`` arou
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..controls import FanucControl
 from ..geometry import PathGeometry
-from ..machine import MachineProfile, load_table
-from ..machine import _check as _check_number
+from ..limits import path_limits
+from ..machine import Machine
 from ..motion import Motion
 from ..physics.servo import PositionLoop
 from ..toolpath import MotionKind, PathMode, Toolpath
@@ -80,223 +88,15 @@ __all__ = [
     "PAPER_SET_1",
     "PAPER_SET_2",
     "FanucRun",
-    "FanucSettings",
     "measure_inposition_times",
     "run",
     "simulate",
 ]
 
-_XYZ = tuple[float, float, float]
-
-
-def _check_choice(name: str, value, allowed: tuple[str, ...]) -> None:
-    if value not in allowed:
-        raise ValueError(
-            f"{name} = {value!r} is out of range: allowed {', '.join(map(repr, allowed))}"
-        )
-
-
-def _check_xyz(name: str, value, hi: float, hi_closed: bool) -> _XYZ:
-    """Three numbers (X, Y, Z), each in (0, hi), as a tuple of floats."""
-    try:
-        v = tuple(value)
-    except TypeError:
-        raise ValueError(f"{name} = {value!r} is out of range: allowed three numbers") from None
-    if len(v) != 3:
-        raise ValueError(f"{name} = {value!r} is out of range: allowed three numbers")
-    for axis, x in zip("XYZ", v, strict=True):
-        _check_number(f"{name}[{axis}]", x, 0.0, hi, hi_closed=hi_closed)
-    return tuple(float(x) for x in v)
-
-
-@dataclass(frozen=True)
-class FanucSettings:
-    """Parameters of the Fanuc-like control, one field per effect; units in the names.
-
-    Defaults are the paper's testbed where the paper gives a value (Lee et al. 2022, Sec. 3,
-    parameter set 1); elsewhere a stated choice, with its reason. Fanuc 0i parameter numbers
-    are given for orientation.
-
-    Parameters
-    ----------
-    interp_period_s : float
-        Interpolation period :math:`T_I`; also the servo's sampling period and the period of the
-        samples. Default 1 ms: a Fanuc 0i interpolates at 1 ms or 2 ms; 1 ms is the period of
-        nctwin's testbed profile (``fanuc_0i_testbed``) and divides every time constant of the
-        paper.
-    cut_accdec : {"linear", "bell", "exponential"}
-        Acc/dec type after interpolation for cutting feed (No. 1610). Default ``"linear"``: the
-        paper's testbed (its Fig. 1 and 2 are trapezoids). ``"bell"`` is two moving averages
-        of :math:`T/2` in cascade: Fanuc's bell type after interpolation reaches the feed in
-        the same time constant :math:`T` as the linear type, with the acceleration ramping up
-        and down (Fanuc gives the bell type after interpolation one time constant, No. 1622, the
-        whole acc/dec time); the cascade of two equal boxes is the FIR that does that (its
-        acceleration is a triangle of peak :math:`2F/T`), where a linear stage followed by a
-        shorter one would need a second constant Fanuc does not have for cutting feed.
-        ``"exponential"`` is Fanuc's oldest type.
-    cut_time_constant_s : float
-        Time constant :math:`T` of cutting acc/dec (No. 1622), in (0, 10] s, a whole number of
-        periods (an even number for ``"bell"``). Default 50 ms: the paper's set 1 (set 2:
-        100 ms).
-    least_increment_mm : float
-        Least command increment (IS-B: 1 um). The exponential filter's tail ends once less than
-        this is left in it on every axis; the rest is output at once. Default 0.001 mm (IS-B,
-        the usual increment of a 0i-MD).
-    rapid_type : {"linear", "nonlinear"}
-        Rapid traverse path (No. 1401#1 LRP): a straight line at path speed :math:`F_r`, or each
-        axis on its own at :math:`F_r` (Lee et al. 2022, Fig. 3). Default ``"linear"``: the
-        paper's testbed.
-    rapid_time_constant_s : float
-        Rapid acc/dec time constant :math:`T_R` (No. 1620), in (0, 10] s, whole periods; it sets
-        the acceleration :math:`F_r / T_R`. Default 150 ms: the paper's set 1 (set 2: 100 ms).
-    rapid_bell_s : float
-        Bell-shaped (S-curve) part of rapid acc/dec :math:`T_S` (No. 1621), in [0, 10] s, whole
-        periods; 0 for linear rapid acc/dec. Default 30 ms: the paper's set 1 (set 2: 20 ms).
-    rapid_overlap : bool
-        Rapid traverse block overlap (No. 1601#4 RTO). Default False: the paper's testbed
-        overlaps no rapid (Sec. 2.2).
-    rapid_overlap_percent : float
-        With ``rapid_overlap``, the next rapid starts once the current one has braked to this
-        share of :math:`F_r` (No. 1722), in [0, 100]. Default 50 %: No. 1722 has no factory
-        value; half the rapid feed is a middle setting.
-    arc_radial_acc_mm_s2 : float
-        Allowed radial acceleration of the feedrate clamp by arc radius, in (0, inf]: an arc of
-        radius :math:`R` runs at most at :math:`\\sqrt{a_r R}` (Fanuc sets it as a feed V for a
-        radius R, No. 1730 and 1731, :math:`a_r = V^2/R`); ``inf`` turns the clamp off.
-        Default 200 mm/s^2 (No. 1730 = 1200 mm/min for No. 1731 = 2 mm): the clamp exists to
-        bound the radial error acc/dec after interpolation causes on arcs; for the linear
-        filter that error is :math:`a_r T^2 / 24`, 21 um at the default 50 ms, the order of a
-        finishing tolerance. It leaves the paper's test piece alone (its smallest arcs, R5 at
-        1000 mm/min, need 56 mm/s^2).
-    block_time_s : float
-        Block-processing time :math:`t_b`: the shortest time a cutting block can take, so a
-        block of length :math:`l` runs at most at :math:`l / t_b`; in [0, 1) s, 0 for no limit.
-        Default 4 ms (250 blocks/s), an assumption: Fanuc publishes block rates only for its
-        high-speed options (AI contour control with high-speed processing, about 1 ms); a 0i-MD
-        running plain acc/dec after interpolation, as the paper's testbed does, buffers and
-        prepares blocks more slowly. At the default a 0.5 mm block runs at most at 7.5 m/min.
-    servo : {"first_order_ff", "second_order"}
-        Servo model. Default ``"first_order_ff"``: a Fanuc position loop (proportional gain over
-        a much faster velocity loop) behaves as a first-order lag of :math:`1/K_p`.
-    position_gain_per_s : tuple of 3 floats
-        Position loop gain :math:`K_p` of X, Y, Z (No. 1825, in 0.01/s), each in (0, 1000).
-        Default 50 1/s on all axes (No. 1825 = 5000): Fanuc's initial value is 3000 (30 1/s);
-        tuned ball-screw axes commonly run at 50-80 1/s; the same on every axis because Fanuc
-        asks for equal gains on axes that interpolate together (unequal gains distort
-        contours). Not fitted to the paper's in-position times.
-    feedforward : float
-        Velocity feed-forward coefficient :math:`f` in [0, 1] (No. 2092 / 10000), for both
-        servo models. Default 0: Fanuc's feed-forward is enabled with its preview control (AI
-        contour control), which the paper's testbed does not use.
-    natural_freq_hz : tuple of 3 floats
-        Natural frequency of the second-order loop of X, Y, Z, each in (0, 1000) Hz. Default
-        11 Hz: with the default damping its following error at constant feed,
-        :math:`2 \\zeta / \\omega_n` times the feed, is that of the first-order default
-        (:math:`1/K_p` = 20 ms), so the two servo models lag alike and differ in transients.
-    damping : tuple of 3 floats
-        Damping ratio :math:`\\zeta` of the second-order loop of X, Y, Z, each in (0, 10].
-        Default 0.7: a well-damped servo tuning (about 5 % overshoot on a step).
-    inposition_width_mm : tuple of 3 floats
-        In-position width of X, Y, Z (No. 1826), each in (0, 10] mm. Default 0.02 mm (No. 1826
-        = 20 at a 1 um detection unit), a common machining-centre setting; the paper does not
-        give its own.
-
-    Raises
-    ------
-    ValueError
-        For a value out of its range, naming the field, the value and the allowed range.
-    """
-
-    interp_period_s: float = 0.001
-    cut_accdec: str = "linear"
-    cut_time_constant_s: float = 0.05
-    least_increment_mm: float = 0.001
-    rapid_type: str = "linear"
-    rapid_time_constant_s: float = 0.15
-    rapid_bell_s: float = 0.03
-    rapid_overlap: bool = False
-    rapid_overlap_percent: float = 50.0
-    arc_radial_acc_mm_s2: float = 200.0
-    block_time_s: float = 0.004
-    servo: str = "first_order_ff"
-    position_gain_per_s: _XYZ = (50.0, 50.0, 50.0)
-    feedforward: float = 0.0
-    natural_freq_hz: _XYZ = (11.0, 11.0, 11.0)
-    damping: _XYZ = (0.7, 0.7, 0.7)
-    inposition_width_mm: _XYZ = (0.02, 0.02, 0.02)
-
-    def __post_init__(self) -> None:
-        _check_number("interp_period_s", self.interp_period_s, 0.0, 0.1, hi_closed=True)
-        _check_choice("cut_accdec", self.cut_accdec, ("linear", "bell", "exponential"))
-        _check_choice("rapid_type", self.rapid_type, ("linear", "nonlinear"))
-        _check_choice("servo", self.servo, ("first_order_ff", "second_order"))
-        if not isinstance(self.rapid_overlap, bool):
-            raise ValueError(
-                f"rapid_overlap = {self.rapid_overlap!r} is out of range: allowed True, False"
-            )
-        # name: (lo, hi, lo closed, hi closed)
-        ranges = {
-            "cut_time_constant_s": (0.0, 10.0, False, True),
-            "rapid_time_constant_s": (0.0, 10.0, False, True),
-            "rapid_bell_s": (0.0, 10.0, True, True),
-            "least_increment_mm": (0.0, 0.1, False, True),
-            "rapid_overlap_percent": (0.0, 100.0, True, True),
-            "arc_radial_acc_mm_s2": (0.0, math.inf, False, True),
-            "block_time_s": (0.0, 1.0, True, False),
-            "feedforward": (0.0, 1.0, True, True),
-        }
-        for name, (lo, hi, lo_closed, hi_closed) in ranges.items():
-            _check_number(name, getattr(self, name), lo, hi, lo_closed=lo_closed,
-                          hi_closed=hi_closed)  # fmt: skip
-        for name, hi, hi_closed in (
-            ("position_gain_per_s", 1000.0, False),
-            ("natural_freq_hz", 1000.0, False),
-            ("damping", 10.0, True),
-            ("inposition_width_mm", 10.0, True),
-        ):
-            object.__setattr__(self, name, _check_xyz(name, getattr(self, name), hi, hi_closed))
-        k_cut = self._periods("cut_time_constant_s", self.cut_time_constant_s)
-        for name in ("rapid_time_constant_s", "rapid_bell_s"):
-            self._periods(name, getattr(self, name))
-        if self.cut_accdec == "bell" and k_cut % 2:
-            raise ValueError(
-                f"cut_time_constant_s = {self.cut_time_constant_s!r} is out of range: allowed "
-                f"even multiples of interp_period_s = {self.interp_period_s!r} with "
-                "cut_accdec = 'bell' (two moving averages of half the time constant)"
-            )
-
-    @classmethod
-    def load(cls, machine: str | Path | None = None) -> FanucSettings:
-        """The ``[fanuc]`` table of a machine profile's file (:func:`nctwin.machine.load_table`);
-        the defaults for the fields it does not set.
-
-        Raises
-        ------
-        ValueError
-            For a field the table names that :class:`FanucSettings` does not have, or a value
-            out of its range.
-        """
-        try:
-            return cls(**load_table(machine, "fanuc"))
-        except TypeError as err:  # a field FanucSettings does not have
-            allowed = ", ".join(f.name for f in fields(cls))
-            raise ValueError(f"[fanuc] of {machine}: {err}; allowed: {allowed}") from None
-
-    def _periods(self, name: str, value_s: float) -> int:
-        """A time constant as a whole number of interpolation periods (ValueError if it is not)."""
-        k = round(value_s / self.interp_period_s)
-        if not math.isclose(k * self.interp_period_s, value_s, rel_tol=1e-9, abs_tol=1e-12):
-            raise ValueError(
-                f"{name} = {value_s!r} is out of range: allowed whole multiples of "
-                f"interp_period_s = {self.interp_period_s!r}"
-            )
-        return k
-
-
 #: Lee et al. 2022, parameter set 1: (ATR, As, AT) = (150, 30, 50) ms (the defaults).
-PAPER_SET_1 = FanucSettings()
+PAPER_SET_1 = FanucControl()
 #: Lee et al. 2022, parameter set 2: (ATR, As, AT) = (100, 20, 100) ms.
-PAPER_SET_2 = FanucSettings(rapid_time_constant_s=0.1, rapid_bell_s=0.02, cut_time_constant_s=0.1)
+PAPER_SET_2 = FanucControl(rapid_time_constant_s=0.1, rapid_bell_s=0.02, cut_time_constant_s=0.1)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -309,7 +109,7 @@ class FanucRun:
     Parameters
     ----------
     motion : Motion
-        Measured motion (the servo output), ``n`` samples at ``interp_period_s``.
+        Measured motion (the servo output), ``n`` samples at ``period_s``.
     command_mm : ndarray, shape (n, 3)
         Command position after acc/dec (what the position loops are given).
     block_feed_mm_s : ndarray, shape (N,)
@@ -341,20 +141,20 @@ class FanucRun:
         return self.motion.cycle_time_s
 
 
-def _servo_matrices(settings: FanucSettings) -> tuple[np.ndarray, np.ndarray]:
+def _servo_matrices(control: FanucControl) -> tuple[np.ndarray, np.ndarray]:
     """Each axis's :class:`~nctwin.physics.servo.PositionLoop`, discretised over a period:
     ``ad`` (3, 2, 2) and ``bd`` (3, 2)."""
     loops = [
         PositionLoop(
-            settings.servo,
-            settings.position_gain_per_s[a],
-            settings.feedforward,
-            settings.natural_freq_hz[a],
-            settings.damping[a],
+            control.servo,
+            control.position_gain_per_s[a],
+            control.feedforward,
+            control.natural_freq_hz[a],
+            control.damping[a],
         )
         for a in range(3)
     ]
-    ad, bd = zip(*(loop.matrices(settings.interp_period_s) for loop in loops), strict=True)
+    ad, bd = zip(*(loop.matrices(control.period_s) for loop in loops), strict=True)
     return np.stack(ad), np.stack(bd)
 
 
@@ -396,20 +196,21 @@ def _ceil(x: np.ndarray) -> np.ndarray:
     return np.ceil(np.asarray(x, dtype=float) - 1e-9).astype(np.int64)
 
 
-def simulate(
-    toolpath: Toolpath, machine: MachineProfile, settings: FanucSettings = PAPER_SET_1
-) -> FanucRun:
+def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER_SET_1) -> FanucRun:
     """Run a program on the Fanuc-like control, one interpolation period at a time.
 
     Parameters
     ----------
     toolpath : Toolpath
         N blocks, continuous (each block starts where the previous one ends).
-    machine : MachineProfile
+    machine : Machine
         The machine: ``rapid_feed_mm_s`` (:math:`F_r`, also each axis's rapid feed for the
-        non-linear type) and ``max_feed_mm_s`` (a larger F is clamped to it). Every control
-        parameter comes from ``settings``.
-    settings : FanucSettings
+        non-linear type), ``max_feed_mm_s`` (a larger F is clamped to it) and the axis
+        velocities (a cutting block's feed is clamped to what they allow along it,
+        :func:`nctwin.limits.path_limits`). The axis accelerations are not read: the control
+        accelerates as its time constants say (:math:`F / T` cutting, :math:`F_r / T_R` on
+        rapids), which a profile sets within them.
+    control : FanucControl
         The control's parameters; default the paper's set 1.
 
     Returns
@@ -424,15 +225,17 @@ def simulate(
     """
     tp = toolpath
     _check_toolpath(tp)
-    s = settings
-    ti = s.interp_period_s
+    s = control
+    ti = s.period_s
     n = len(tp)
     kind = np.ascontiguousarray(tp.kind, dtype=np.int64)
     cut = (kind != MotionKind.RAPID) & (kind != MotionKind.DWELL)
     lengths = tp.lengths_mm
-    # ---- feed of each cutting block: F, the machine's maximum, the arc clamp, block time
+    # ---- feed of each cutting block: F, the machine's maximum and axis velocities, the arc
+    # clamp, block time
     with np.errstate(invalid="ignore", divide="ignore"):
         feed = np.minimum(tp.feed_mm_s, machine.max_feed_mm_s)
+        feed = np.minimum(feed, path_limits(tp, machine).velocity_mm_s)
         arc_limit = np.sqrt(s.arc_radial_acc_mm_s2 * tp.radius_mm)
         feed = np.where(tp.is_arc, np.minimum(feed, arc_limit), feed)
         if s.block_time_s > 0:
@@ -458,10 +261,10 @@ def simulate(
     stop_after = cut & exact
     pause_n = np.where(kind == MotionKind.DWELL, _ceil(tp.dwell_s / ti), 0)
     # ---- filters and servo
-    k_cut = s._periods("cut_time_constant_s", s.cut_time_constant_s)
+    k_cut = s.periods("cut_time_constant_s")
     exp_cut = s.cut_accdec == "exponential"
     k1, k2 = {"linear": (k_cut, 1), "bell": (k_cut // 2, k_cut // 2)}.get(s.cut_accdec, (1, 1))
-    k_bell = max(s._periods("rapid_bell_s", s.rapid_bell_s), 1)
+    k_bell = max(s.periods("rapid_bell_s"), 1)
     exp_keep = math.exp(-ti / s.cut_time_constant_s)
     exp_gain = s.cut_time_constant_s / ti * (1.0 - exp_keep)
     fr = machine.rapid_feed_mm_s
@@ -511,16 +314,14 @@ def simulate(
     return FanucRun(motion, cmd, feed, times, wait, cmd_end)
 
 
-def run(
-    toolpath: Toolpath, machine: MachineProfile, settings: FanucSettings = PAPER_SET_1
-) -> Motion:
+def run(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER_SET_1) -> Motion:
     """Measured motion of ``toolpath`` on the Fanuc-like control (see :func:`simulate`)."""
-    return simulate(toolpath, machine, settings).motion
+    return simulate(toolpath, machine, control).motion
 
 
 def measure_inposition_times(
-    machine: MachineProfile,
-    settings: FanucSettings = PAPER_SET_1,
+    machine: Machine,
+    control: FanucControl = PAPER_SET_1,
     *,
     distances_mm: tuple[float, ...] = (20.0, 50.0, 100.0, 150.0, 200.0),
 ) -> np.ndarray:
@@ -533,8 +334,8 @@ def measure_inposition_times(
 
     Parameters
     ----------
-    machine : MachineProfile
-    settings : FanucSettings
+    machine : Machine
+    control : FanucControl
     distances_mm : tuple of float
         Travels of the measured rapids, each > 0.
 
@@ -562,5 +363,5 @@ def measure_inposition_times(
             end[0, a] = x
             tp = Toolpath(np.zeros((1, 3)), end, np.array([MotionKind.RAPID]), np.full(1, np.nan),
                           nan3, z1, z1, z1, z1, np.full(1, np.nan), np.full(1, np.nan))  # fmt: skip
-            out[a] += simulate(tp, machine, settings).inposition_wait_s[0]
+            out[a] += simulate(tp, machine, control).inposition_wait_s[0]
     return out / len(dist)

@@ -39,81 +39,28 @@ Conventions: the filters act on the command positions sampled at the interpolati
 from __future__ import annotations
 
 import dataclasses
-import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from .._rows import row_min, row_norm
+from ..controls import FirControl
 from ..geometry import PathGeometry
-from ..machine import MachineProfile, load_table
+from ..limits import path_limits
+from ..machine import Machine
 from ..motion import Motion
-from ..toolpath import MotionKind, PathMode, Toolpath
+from ..toolpath import MotionKind, Toolpath
 from . import _fir_loops
 
-__all__ = ["FirFilter", "FirSettings", "corner_deviation_mm", "plan", "run", "stand_in"]
-
-
-@dataclass(frozen=True)
-class FirSettings:
-    """How the FIR kernel interpolates a machine: the kernel's settings, apart from what the
-    machine is (:class:`~nctwin.machine.MachineProfile`).
-
-    Parameters
-    ----------
-    t1_s, t2_s : float
-        Time constants of the two moving averages: acceleration ``F / T1``, jerk
-        ``F / (T1 T2)``; in [0, 10] s (the longer must be at least one period).
-    acc_scale : float
-        The kernel enforces the axis accelerations times this, in (0, 100) (1 for the kernel's
-        own machines; fitted where the kernel stands in for another control).
-    blend_ratio : float
-        The kernel blends a junction within at most this share of the shorter of its two moves
-        (a plain ``G64`` within this alone), in (0, 1]; ``inf``: the program's tolerance only.
-    block_periods : int
-        Shortest time of a move, in periods (a control's block-processing rate): a move of
-        length ``l`` runs at most at ``l / (n period_s)``; in [0, 100], 0: no limit.
-    """
-
-    t1_s: float = 0.05
-    t2_s: float = 0.01
-    acc_scale: float = 1.0
-    blend_ratio: float = math.inf
-    block_periods: int = 0
-
-    def __post_init__(self) -> None:
-        for name in ("t1_s", "t2_s"):
-            v = getattr(self, name)
-            if not (_is_number(v) and 0.0 <= v <= 10.0):
-                raise ValueError(f"{name} = {v!r} is out of range: allowed [0, 10]")
-        if not (_is_number(self.acc_scale) and 0.0 < self.acc_scale < 100.0):
-            raise ValueError(f"acc_scale = {self.acc_scale!r} is out of range: allowed (0, 100)")
-        r = self.blend_ratio
-        if not (_is_number(r) and (0.0 < r <= 1.0 or r == math.inf)):
-            raise ValueError(f"blend_ratio = {r!r} is out of range: allowed (0, 1] or inf")
-        n = self.block_periods
-        if not (isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 100):
-            raise ValueError(f"block_periods = {n!r} is out of range: allowed integers in [0, 100]")
-
-    @classmethod
-    def load(cls, machine: str | Path | None = None) -> FirSettings:
-        """The ``[fir]`` table of a profile's file (:func:`nctwin.machine.load_table`); the
-        defaults where it has none."""
-        data = load_table(machine, "fir")
-        allowed = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - allowed)
-        if unknown:
-            raise ValueError(
-                f"[fir] of {machine}: unknown field(s) {', '.join(unknown)}; allowed: "
-                f"{', '.join(sorted(allowed))}"
-            )
-        return cls(**data)
-
-
-def _is_number(v) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and not math.isnan(v)
+__all__ = [
+    "FirFilter",
+    "corner_deviation_mm",
+    "enforced_machine",
+    "plan",
+    "run",
+    "stand_in",
+]
 
 
 @dataclass(frozen=True)
@@ -144,10 +91,10 @@ class FirFilter:
                 )
 
     @classmethod
-    def of(cls, settings: FirSettings, period_s: float) -> FirFilter:
-        """The filter of the kernel's settings (the longer time constant first)."""
-        t1, t2 = max(settings.t1_s, settings.t2_s), min(settings.t1_s, settings.t2_s)
-        return cls(t1, t2, period_s)
+    def of(cls, control: FirControl) -> FirFilter:
+        """The filter of the control's settings (the longer time constant first)."""
+        t1, t2 = max(control.t1_s, control.t2_s), min(control.t1_s, control.t2_s)
+        return cls(t1, t2, control.period_s)
 
     @property
     def taps(self) -> tuple[int, int]:
@@ -235,38 +182,33 @@ class Plan:
     pause_s: np.ndarray
 
 
-def _block_feeds(tp: Toolpath, machine: MachineProfile, fir: FirFilter) -> np.ndarray:
-    """Cruise feed of each block (mm/s), shape (N,): programmed feed within every limit."""
+def _block_feeds(
+    tp: Toolpath, machine: Machine, fir: FirFilter, feed_mm_s: np.ndarray, tol_mm: np.ndarray
+) -> np.ndarray:
+    """Cruise feed of each block (mm/s), shape (N,): the programmed feed ``feed_mm_s`` (N,)
+    within every limit (:func:`nctwin.limits.path_limits` of the axes' velocities and of the
+    velocity steps the filters make of their accelerations and jerks; on arcs, the centripetal
+    acceleration and the filter's radial shrinkage within the tolerance ``tol_mm`` (N,))."""
     kind = tp.kind
     f = np.where(
         kind == MotionKind.RAPID,
         machine.rapid_feed_mm_s,
-        np.minimum(np.nan_to_num(tp.feed_mm_s, nan=np.inf), machine.max_feed_mm_s),
+        np.minimum(np.nan_to_num(feed_mm_s, nan=np.inf), machine.max_feed_mm_s),
     )
     vmax = np.asarray(machine.axis_max_velocity_mm_s)
     amax = np.asarray(machine.axis_max_acceleration_mm_s2)
     jmax = np.asarray(machine.axis_max_jerk_mm_s3)
-    # largest share of the feed any axis takes: chord direction for lines, full for arc planes
-    share = np.abs(tp.directions)
-    arc = tp.is_arc
-    if arc.any():
-        ax = tp._plane_axes[arc]
-        rows = np.arange(int(arc.sum()))
-        s = np.abs(tp.start_tangents[arc])
-        s[rows, ax[:, 0]] = 1.0
-        s[rows, ax[:, 1]] = 1.0
-        share[arc] = s
+    limits = path_limits(tp, machine)
     with np.errstate(divide="ignore"):
         step = amax * fir.t1_s
         if fir.t2_s > 0:
             step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
-        f = np.minimum(f, row_min(np.minimum(vmax, step) / share))
+        f = np.minimum(f, limits.cap(np.minimum(vmax, step)))
+        arc = tp.is_arc
         if arc.any():
             r = tp.radius_mm[arc]
-            a_plane = np.minimum(amax[ax[:, 0]], amax[ax[:, 1]])
-            tol = tp.effective_tolerance_mm(machine.blend_tol_mm)[arc]
-            v_arc = np.sqrt(a_plane * r)  # centripetal acceleration
-            v_shrink = np.sqrt(2.0 * r * tol / fir.variance_s2)  # radial shrink of the filter
+            v_arc = np.sqrt(limits.acceleration_mm_s2[arc] * r)  # centripetal acceleration
+            v_shrink = np.sqrt(2.0 * r * tol_mm[arc] / fir.variance_s2)  # filter's radial shrink
             f[arc] = np.minimum(f[arc], np.minimum(v_arc, v_shrink))
     f[kind == MotionKind.DWELL] = np.inf
     return f
@@ -312,24 +254,33 @@ def _deviation_nodes(fir: FirFilter) -> tuple[np.ndarray, np.ndarray]:
 
 
 def plan(
-    tp: Toolpath,
-    machine: MachineProfile,
-    fir: FirFilter,
-    geo: PathGeometry | None = None,
+    tp: Toolpath, machine: Machine, control: FirControl, *, geo: PathGeometry | None = None
 ) -> Plan:
     """Look-ahead: cruise feeds, junction speeds and pauses (see the module docstring).
 
-    ``geo`` defaults to the path's geometry."""
+    Parameters
+    ----------
+    tp : Toolpath
+        N blocks.
+    machine : Machine
+        The limits (the accelerations times ``control.acc_scale``, :func:`enforced_machine`).
+    control : FirControl
+        The filters, and the feeds and tolerances the kernel runs (:func:`stand_in`).
+    geo : PathGeometry, optional
+        The path's geometry (computed if not given).
+    """
     n = len(tp)
     geo = geo if geo is not None else PathGeometry(tp)
-    feed = _block_feeds(tp, machine, fir)
+    machine = enforced_machine(machine, control)
+    fir = FirFilter.of(control)
+    feed_mm_s, tol = stand_in(tp, control)
+    feed = _block_feeds(tp, machine, fir, feed_mm_s, tol)
     v = np.zeros(n + 1)
     pause = np.zeros(n + 1)
     if n == 0:
         return Plan(feed, v, pause)
     amax = np.asarray(machine.axis_max_acceleration_mm_s2)
     jmax = np.asarray(machine.axis_max_jerk_mm_s3)
-    tol = tp.effective_tolerance_mm(machine.blend_tol_mm)
     dwell = tp.kind == MotionKind.DWELL
 
     j = np.arange(1, n)  # junction j: end of block j-1, start of block j
@@ -586,54 +537,53 @@ def _moves(tp: Toolpath) -> np.ndarray:
     return moves
 
 
-def stand_in(
-    toolpath: Toolpath, machine: MachineProfile, settings: FirSettings
-) -> tuple[Toolpath, MachineProfile]:
-    """The tool path and profile the kernel plans, with the settings that make it stand in for
-    another control: ``acc_scale`` scales the axis accelerations; ``blend_ratio`` lowers the
-    tolerance of each junction to that share of the shorter of its two moves (written as the
-    ``G64 P`` of the block that starts there); ``block_periods`` caps the feed of each cutting
-    move at its length over that many periods. With the defaults (1, inf, 0) both come back
-    unchanged.
+def enforced_machine(machine: Machine, control: FirControl) -> Machine:
+    """The limits the kernel keeps to: ``machine`` with its axis accelerations times
+    ``control.acc_scale`` (itself where that is 1)."""
+    if control.acc_scale == 1.0:
+        return machine
+    acc = tuple(control.acc_scale * a for a in machine.axis_max_acceleration_mm_s2)
+    return dataclasses.replace(machine, axis_max_acceleration_mm_s2=acc)
+
+
+def stand_in(toolpath: Toolpath, control: FirControl) -> tuple[np.ndarray, np.ndarray]:
+    """The feed and the blending tolerance of each block as the kernel runs them, shapes
+    (N,).
+
+    The tolerance is the program's (``G64 P``) or else the control's, lowered by
+    ``blend_ratio`` to that share of the shorter of the junction's two moves; ``block_periods``
+    caps the feed of each cutting move at its length over that many periods. These two make
+    the kernel stand in for another control; with their defaults (inf, 0) the programmed feeds
+    and the tolerances come back unchanged.
     """
-    if settings.acc_scale != 1.0:
-        acc = tuple(settings.acc_scale * a for a in machine.axis_max_acceleration_mm_s2)
-        machine = dataclasses.replace(machine, axis_max_acceleration_mm_s2=acc)
-    if settings.blend_ratio == np.inf and settings.block_periods == 0:
-        return toolpath, machine
+    tol = toolpath.effective_tolerance_mm(control.blend_tol_mm)
+    feed = toolpath.feed_mm_s
+    if control.blend_ratio == np.inf and control.block_periods == 0:
+        return feed, tol
     length = toolpath.lengths_mm
     moving = length > 0
-    tol = toolpath.effective_tolerance_mm(machine.blend_tol_mm)
     prev = np.full(len(toolpath), np.inf)
     idx = np.flatnonzero(moving)
     prev[idx[1:]] = length[idx[:-1]]
-    limit = np.where(moving, settings.blend_ratio * np.minimum(length, prev), np.inf)
-    new_tol = np.where(tol > 0, np.minimum(tol, limit), tol)
-    blend = np.isfinite(new_tol) & (new_tol > 0) & (new_tol != tol)
-    feed = toolpath.feed_mm_s
-    if settings.block_periods:
-        cap = length / (settings.block_periods * machine.period_s)
+    limit = np.where(moving, control.blend_ratio * np.minimum(length, prev), np.inf)
+    tol = np.where(tol > 0, np.minimum(tol, limit), tol)
+    if control.block_periods:
+        cap = length / (control.block_periods * control.period_s)
         feed = np.where((toolpath.kind != MotionKind.RAPID) & moving, np.minimum(feed, cap), feed)
-    toolpath = dataclasses.replace(
-        toolpath,
-        feed_mm_s=feed,
-        path_mode=np.where(blend, PathMode.BLEND, toolpath.path_mode).astype(np.int8),
-        blend_tol_mm=np.where(blend, new_tol, toolpath.blend_tol_mm),
-    )
-    return toolpath, machine
+    return feed, tol
 
 
-def run(toolpath: Toolpath, machine: MachineProfile, settings: FirSettings) -> Motion:
+def run(toolpath: Toolpath, machine: Machine, control: FirControl) -> Motion:
     """Interpolate a tool path on the FIR kernel.
 
     Parameters
     ----------
     toolpath : Toolpath
-    machine : MachineProfile
-        Supplies ``period_s``, ``blend_tol_mm``, the axis limits, the rapid feed and the
-        maximum feed.
-    settings : FirSettings
-        The kernel's filters and stand-in settings (:func:`stand_in`).
+    machine : Machine
+        The axis limits, the rapid feed and the maximum feed.
+    control : FirControl
+        The period, the default tolerance, the filters and the stand-in settings
+        (:func:`enforced_machine`, :func:`stand_in`).
 
     Returns
     -------
@@ -641,8 +591,7 @@ def run(toolpath: Toolpath, machine: MachineProfile, settings: FirSettings) -> M
         Samples every ``period_s`` from rest at the start to rest at the end, labelled with
         the blocks of ``toolpath``.
     """
-    toolpath, machine = stand_in(toolpath, machine, settings)
-    fir = FirFilter.of(settings, machine.period_s)
+    fir = FirFilter.of(control)
     ts = fir.period_s
     # zero-length moves are no-ops: plan without them, report the kept blocks' indices
     kept = np.flatnonzero(_moves(toolpath) | (toolpath.kind == MotionKind.DWELL))
@@ -651,7 +600,8 @@ def run(toolpath: Toolpath, machine: MachineProfile, settings: FirSettings) -> M
         z = np.zeros((1, 3))
         return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), ts)
     geo = PathGeometry(tp)
-    cmd = _command(tp, geo, plan(tp, machine, fir, geo), fir)
+    cmd = _command(tp, geo, plan(tp, machine, control, geo=geo), fir)
+    machine = enforced_machine(machine, control)
     limits = np.array(
         [
             machine.axis_max_velocity_mm_s,

@@ -7,14 +7,16 @@ a program on it and returns the same :class:`~nctwin.motion.Motion` as the virtu
 
 How a run works
 ---------------
-* The INI and HAL files are generated from a :class:`~nctwin.machine.MachineProfile`
-  (:func:`ini_text`, :func:`hal_text`): trivkins XYZ, servo period = ``period_s``,
+* The INI and HAL files are generated from a :class:`~nctwin.machine.Machine` and the
+  :class:`~nctwin.controls.PlannerControl` of its profile (:func:`ini_text`, :func:`hal_text`):
+  trivkins XYZ, servo and trajectory period = the control's ``period_s``,
   ``[AXIS_*]``/``[JOINT_*]`` limits from the axis limits, ``[TRAJ]`` ``MAX_LINEAR_VELOCITY`` =
   ``max_feed_mm_s``, ``MAX_LINEAR_ACCELERATION`` = the largest axis acceleration, no
   ``ARC_BLEND_*`` settings (LinuxCNC's defaults), no homing, start at X0 Y0 Z0, and the startup
-  code ``G21 G90 G64 P<blend_tol_mm> Q0``, so a program that sets no ``G61``/``G64`` blends within
-  the profile's tolerance without merging segments (LinuxCNC's own default is ``G64 P0.0254 Q0``;
-  a ``G64 P`` without Q sets Q = P, which turns on its naive-CAM detector). A plain ``G64`` (no
+  code ``G21 G90 G64 P<blend_tol_mm> Q0`` (the control's), so a program that sets no
+  ``G61``/``G64`` blends within that tolerance without merging segments (LinuxCNC's own
+  default is ``G64 P0.0254 Q0``; a ``G64 P`` without Q sets Q = P, which turns on its
+  naive-CAM detector). A plain ``G64`` (no
   P) means P0 on LinuxCNC: no tolerance.
 * Each run gets its own folder and private namespaces (``unshare``: PID, mount, IPC, network):
   the folder is the instance's ``/tmp`` and ``HOME``, ``/dev/shm`` is a fresh tmpfs. Instances
@@ -58,8 +60,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..controls import PlannerControl
 from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, dump, parse
-from ..machine import MachineProfile
+from ..machine import Machine
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
 
@@ -131,8 +134,8 @@ def _faketime_lib() -> str | None:
     return found[0] if found else None
 
 
-def _limits(machine: MachineProfile) -> None:
-    """Raise ValueError where the profile says what LinuxCNC cannot do."""
+def _limits(machine: Machine, control: PlannerControl) -> None:
+    """Raise ValueError where the machine or its control asks what LinuxCNC cannot do."""
     if any(j != float("inf") for j in machine.axis_max_jerk_mm_s3):
         raise ValueError(
             f"axis_max_jerk_mm_s3 = {machine.axis_max_jerk_mm_s3!r} is out of range for "
@@ -143,16 +146,17 @@ def _limits(machine: MachineProfile) -> None:
             f"rapid_feed_mm_s = {machine.rapid_feed_mm_s!r} is out of range for LinuxCNC: "
             f"allowed max_feed_mm_s = {machine.max_feed_mm_s!r} (one MAX_LINEAR_VELOCITY)"
         )
-    period_ns = machine.period_s * 1e9
+    period_ns = control.period_s * 1e9
     if abs(period_ns - round(period_ns)) > 1e-6:
         raise ValueError(
-            f"period_s = {machine.period_s!r} is out of range for LinuxCNC: allowed whole "
+            f"period_s = {control.period_s!r} is out of range for LinuxCNC: allowed whole "
             "nanoseconds"
         )
 
 
-def ini_text(machine: MachineProfile) -> str:
-    """The INI file of a LinuxCNC instance for ``machine`` (see the module docstring).
+def ini_text(machine: Machine, control: PlannerControl) -> str:
+    """The INI file of a LinuxCNC instance for ``machine`` under ``control`` (see the module
+    docstring).
 
     Raises
     ------
@@ -160,7 +164,7 @@ def ini_text(machine: MachineProfile) -> str:
         If the profile has a finite jerk limit, a rapid feed other than its maximum feed, or a
         period that is not a whole number of nanoseconds.
     """
-    _limits(machine)
+    _limits(machine, control)
     d = INSTANCE_DIR
     vmax, amax = machine.axis_max_velocity_mm_s, machine.axis_max_acceleration_mm_s2
     lines = [
@@ -172,14 +176,14 @@ def ini_text(machine: MachineProfile) -> str:
         f"DISPLAY = {d}/display.py",
         "[TASK]",
         "TASK = milltask",
-        f"CYCLE_TIME = {machine.period_s!r}",
+        f"CYCLE_TIME = {control.period_s!r}",
         "[RS274NGC]",
         f"PARAMETER_FILE = {d}/sim.var",
-        f"RS274NGC_STARTUP_CODE = G21 G90 G64 P{machine.blend_tol_mm!r} Q0",
+        f"RS274NGC_STARTUP_CODE = G21 G90 G64 P{control.blend_tol_mm!r} Q0",
         "[EMCMOT]",
         "EMCMOT = motmod",
         "COMM_TIMEOUT = 1.0",
-        f"SERVO_PERIOD = {round(machine.period_s * 1e9)}",
+        f"SERVO_PERIOD = {round(control.period_s * 1e9)}",
         "[EMCIO]",
         "EMCIO = io",
         "CYCLE_TIME = 0.1",
@@ -285,7 +289,12 @@ def _check_run_args(timeout_s: float, speed: float) -> None:
 
 
 def record(
-    program: str, machine: MachineProfile, *, timeout_s: float = 600.0, speed: float = 5
+    program: str,
+    machine: Machine,
+    control: PlannerControl,
+    *,
+    timeout_s: float = 600.0,
+    speed: float = 5,
 ) -> Recording:
     """Run a program on a fresh LinuxCNC instance and return what the sampler recorded.
 
@@ -293,7 +302,9 @@ def record(
     ----------
     program : str
         G-code text as LinuxCNC reads it (``M2`` is appended if the program has no end).
-    machine : MachineProfile
+    machine : Machine
+    control : PlannerControl
+        The period and the startup tolerance (:func:`ini_text`).
     timeout_s : float
         Wall-clock limit of the whole run (start-up, program, shut-down); the instance is
         killed when it is reached.
@@ -314,7 +325,7 @@ def record(
         If LinuxCNC's motion controller reports an error (a busy machine at a high speed-up).
     """
     _check_run_args(timeout_s, speed)
-    ini = ini_text(machine)
+    ini = ini_text(machine, control)
     why = available()
     if why:
         raise LinuxCNCUnavailable(f"LinuxCNC cannot run: {why}")
@@ -378,7 +389,7 @@ def record(
         samples = _read_samples(folder / "samples.txt")
     finally:
         shutil.rmtree(folder, ignore_errors=True)
-    return _trim(samples, machine.period_s, console)
+    return _trim(samples, control.period_s, console)
 
 
 def _rejected(message: str, program: str) -> LinuxCNCError:
@@ -420,7 +431,8 @@ def _trim(data: np.ndarray, period_s: float, console: str) -> Recording:
 
 def run(
     toolpath_or_program: Toolpath | str,
-    machine: MachineProfile,
+    machine: Machine,
+    control: PlannerControl,
     *,
     timeout_s: float = 600.0,
     speed: float = 5,
@@ -432,9 +444,10 @@ def run(
     toolpath_or_program : Toolpath or str
         A tool path (written with :func:`nctwin.gcode.dump`), or G-code text, which LinuxCNC
         runs as written and :func:`nctwin.gcode.parse` reads for the block numbers.
-    machine : MachineProfile
-        Its axis limits, maximum feed, period and blending tolerance make the INI
-        (:func:`ini_text`).
+    machine : Machine
+        Its axis limits and maximum feed make the INI (:func:`ini_text`).
+    control : PlannerControl
+        Its period and blending tolerance too.
     timeout_s, speed : float
         See :func:`record`.
 
@@ -470,8 +483,8 @@ def run(
     if not ((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL)).any():
         # nothing moves: one sample at LinuxCNC's start position, without starting it
         z = np.zeros((1, 3))
-        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), machine.period_s)
-    rec = record(text, machine, timeout_s=timeout_s, speed=speed)
+        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), control.period_s)
+    rec = record(text, machine, control, timeout_s=timeout_s, speed=speed)
     motion = motion_of(rec, tp)
     last = int(np.flatnonzero((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL))[-1])
     if motion.block[-1] < last or not np.allclose(motion.pos_mm[-1], tp.end_mm[last], atol=1e-6):

@@ -49,7 +49,8 @@ import math
 
 import numpy as np
 
-from ..machine import MachineProfile, whole_periods
+from ..controls import AccDecControl
+from ..machine import Machine
 from ..toolpath import MotionKind, PathMode, Toolpath
 
 __all__ = ["block_times", "check_program", "overlapped_block_times"]
@@ -95,15 +96,20 @@ def check_program(toolpath: Toolpath, source: str = "<program>") -> None:
             raise ValueError(f"{source}:{toolpath.line[k]}: {reason}")
 
 
-def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.ndarray]:
+def block_times(
+    toolpath: Toolpath, machine: Machine, control: AccDecControl
+) -> dict[str, np.ndarray]:
     """Per-block times without overlap (Sec. 2.1, eq. 1-16).
 
     Parameters
     ----------
     toolpath : Toolpath
         N blocks.
-    machine : MachineProfile
-        TI, AT, ATR, As, Fr, rapid type and maximum feed.
+    machine : Machine
+        Fr (``rapid_feed_mm_s``) and the maximum feed; nothing else of it (the paper's
+        method knows no axis limits).
+    control : AccDecControl
+        TI, AT, ATR, As and the rapid type.
 
     Returns
     -------
@@ -112,15 +118,14 @@ def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.nda
         which the next block of a chain may start (:math:`\\lceil l/F \\rceil_{T_I}`, cutting
         blocks only, else ``T``); ``"short"`` whether the block is short (cutting or rapid).
     """
-    ti = machine.period_s
+    ti = control.period_s
     at, atr, bell = (
-        machine.cut_time_constant_s,
-        machine.rapid_time_constant_s,
-        machine.rapid_bell_s,
+        control.cut_time_constant_s,
+        control.rapid_time_constant_s,
+        control.rapid_bell_s,
     )
-    whole_periods("cut_time_constant_s", at, ti)
-    whole_periods("rapid_time_constant_s", atr, ti)
-    whole_periods("rapid_bell_s", bell, ti)
+    for name in ("cut_time_constant_s", "rapid_time_constant_s", "rapid_bell_s"):
+        control.periods(name)  # ValueError unless a whole number of periods
     kind = toolpath.kind
     lengths = toolpath.lengths_mm
     cut = np.isin(kind, _CUT)
@@ -141,7 +146,7 @@ def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.nda
     t_cut = np.where(tb_cut > 0, tb_cut + at, 0.0)
 
     d = np.abs(toolpath.end_mm - toolpath.start_mm)
-    travel = lengths if machine.rapid_type == "linear" else d.max(axis=1)  # eq. 6 / eq. 7
+    travel = lengths if control.rapid_type == "linear" else d.max(axis=1)  # eq. 6 / eq. 7
     fr = machine.rapid_feed_mm_s
     tb_r = np.where(rapid & (travel > 0), _ceil_ti(travel / fr, ti), 0.0)
     short_r = rapid & (tb_r > 0) & (tb_r < atr - 1e-12)
@@ -158,7 +163,8 @@ def block_times(toolpath: Toolpath, machine: MachineProfile) -> dict[str, np.nda
 
 def overlapped_block_times(
     toolpath: Toolpath,
-    machine: MachineProfile,
+    machine: Machine,
+    control: AccDecControl,
     *,
     overlap: bool = True,
     inposition: bool = True,
@@ -171,16 +177,17 @@ def overlapped_block_times(
     ----------
     toolpath : Toolpath
         N blocks.
-    machine : MachineProfile
-        Control parameters (see :func:`block_times`); ``inposition_time_s`` is the default
-        in-position table.
+    machine : Machine
+    control : AccDecControl
+        As for :func:`block_times`; ``control.inposition_time_s`` is the default in-position
+        table.
     overlap : bool
         Apply block overlap between consecutive cutting blocks (Sec. 2.2). False gives the
         ablation "no block overlap": every block's full :math:`T` is added.
     inposition : bool
         Add the in-position time after rapids (Sec. 2.3). False gives the ablation.
     inposition_s : array-like, shape (3,), optional
-        Measured in-position times of X, Y, Z (s); default ``machine.inposition_time_s``.
+        Measured in-position times of X, Y, Z (s); default ``control.inposition_time_s``.
 
     Returns
     -------
@@ -193,7 +200,7 @@ def overlapped_block_times(
         feed, or ``inposition_s`` is not three non-negative numbers.
     """
     n = len(toolpath)
-    bt = block_times(toolpath, machine)
+    bt = block_times(toolpath, machine, control)
     t, advance = bt["T"], bt["advance"]
     cut = np.isin(toolpath.kind, _CUT)
     out = t.copy()
@@ -213,7 +220,7 @@ def overlapped_block_times(
         tail = np.where(cut[last_idx], end - adv_total, 0.0)
         out[last_idx] += tail
     if inposition:
-        tab = machine.inposition_time_s if inposition_s is None else inposition_s
+        tab = control.inposition_time_s if inposition_s is None else inposition_s
         tab = np.asarray(tab, dtype=float)
         if tab.shape != (3,) or not np.all(np.isfinite(tab)) or np.any(tab < 0):
             raise ValueError(
