@@ -1,4 +1,4 @@
-"""The Fanuc-like acc/dec kernel against times and speeds computed by hand."""
+"""The ideal acc/dec kernel (nctwin.kernel.accdec) against times and speeds computed by hand."""
 
 from __future__ import annotations
 
@@ -11,21 +11,25 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from nctwin import parse
+from nctwin.controls import AccDecControl
 from nctwin.kernel.accdec import measure_inposition_times, run, simulate
-from nctwin.machine import MachineProfile
+from nctwin.machine import Machine
 from nctwin.physics.servo import PositionLoop
 
 TI = 0.001
 FR = 10000.0 / 60.0  # rapid feed, mm/s
 
-MACHINE = MachineProfile(
+MACHINE = Machine(
     name="hand",
-    description="paper set 1 with round servo numbers",
+    description="the paper's testbed: rapid feed 10,000 mm/min",
     axis_max_velocity_mm_s=(200.0, 200.0, 200.0),
     axis_max_acceleration_mm_s2=(2000.0, 2000.0, 2000.0),
     axis_max_jerk_mm_s3=(math.inf,) * 3,
     rapid_feed_mm_s=FR,
     max_feed_mm_s=FR,
+)
+#: paper set 1 with round servo numbers
+CONTROL = AccDecControl(
     period_s=TI,
     cut_time_constant_s=0.05,
     rapid_time_constant_s=0.15,
@@ -37,7 +41,7 @@ MACHINE = MachineProfile(
 
 def test_one_normal_block_takes_l_over_f_plus_at():
     # 10 mm at 10 mm/s: 1 s of interpolation + AT = 50 ms of acc/dec (eq. 3)
-    r = simulate(parse("G1 X10 F600"), MACHINE)
+    r = simulate(parse("G1 X10 F600"), MACHINE, CONTROL)
     assert r.cycle_time_s == pytest.approx(1.05, abs=1e-12)
     speed = r.motion.speed_mm_s
     assert speed.max() == pytest.approx(10.0, rel=1e-9)
@@ -50,13 +54,13 @@ def test_one_normal_block_takes_l_over_f_plus_at():
 
 def test_short_block_never_reaches_the_feed():
     # 0.3 mm at 10 mm/s: 30 ms < AT; a trapezoid of 30 + 50 ms peaking at F * 30 / 50 (eq. 4-5)
-    r = simulate(parse("G1 X0.3 F600"), MACHINE)
+    r = simulate(parse("G1 X0.3 F600"), MACHINE, CONTROL)
     assert r.cycle_time_s == pytest.approx(0.08, abs=1e-12)
     assert r.motion.speed_mm_s.max() == pytest.approx(6.0, rel=1e-9)
 
 
 def test_two_cutting_blocks_overlap_by_at():
-    r = simulate(parse("G1 X10 F600\nG1 X20"), MACHINE)
+    r = simulate(parse("G1 X10 F600\nG1 X20"), MACHINE, CONTROL)
     assert r.cycle_time_s == pytest.approx(1.0 + 1.0 + 0.05, abs=1e-12)
     # collinear blocks overlap seamlessly: no dip in speed at the junction
     speed = r.motion.speed_mm_s
@@ -65,7 +69,7 @@ def test_two_cutting_blocks_overlap_by_at():
 
 
 def test_corner_blends_both_axes_during_at():
-    r = simulate(parse("G1 X10 F600\nG1 Y10"), MACHINE)
+    r = simulate(parse("G1 X10 F600\nG1 Y10"), MACHINE, CONTROL)
     vel = r.motion.vel_mm_s
     # 25 ms after the corner both axes move at about half the feed (overlap, Fig. 6)
     assert vel[1025, 0] == pytest.approx(10.0 * (1 - 24.5 / 50.0), rel=1e-9)
@@ -74,7 +78,7 @@ def test_corner_blends_both_axes_during_at():
 
 def test_long_rapid_command_and_inposition():
     # 100 mm at Fr: ceil(0.6 s) + ATR 150 ms + As 30 ms (eq. 13), then in-position
-    r = simulate(parse("G0 X100"), MACHINE)
+    r = simulate(parse("G0 X100"), MACHINE, CONTROL)
     assert r.command_end_s[0] == pytest.approx(0.6 + 0.15 + 0.03, abs=1e-12)
     wait = r.inposition_wait_s[0]
     assert 0 < wait < 0.2
@@ -86,14 +90,14 @@ def test_long_rapid_command_and_inposition():
 
 def test_short_rapid_is_a_triangle():
     # 1 mm: a = Fr / ATR = 1111.1 mm/s^2, Ta = ceil(sqrt(1 / a)) = 30 ms, T = 2 Ta + As (eq. 15)
-    r = simulate(parse("G0 X1"), MACHINE)
+    r = simulate(parse("G0 X1"), MACHINE, CONTROL)
     assert r.command_end_s[0] == pytest.approx(0.06 + 0.03, abs=1e-12)
     assert np.abs(r.motion.acc_mm_s2[:, 0]).max() <= FR / 0.15 * (1 + 1e-6)
 
 
 def test_nonlinear_rapid_moves_each_axis_at_the_rapid_feed():
-    m = dataclasses.replace(MACHINE, rapid_type="nonlinear")
-    r = simulate(parse("G0 X100 Y10"), m)
+    c = dataclasses.replace(CONTROL, rapid_type="nonlinear")
+    r = simulate(parse("G0 X100 Y10"), MACHINE, c)
     # the longest axis decides (eq. 14): X 100 mm as if alone
     assert r.command_end_s[0] == pytest.approx(0.6 + 0.15 + 0.03, abs=1e-12)
     # Y (10 mm) is a short rapid on its own: Ta = ceil(sqrt(10 / 1111.1)) = 95 ms, then As
@@ -101,27 +105,39 @@ def test_nonlinear_rapid_moves_each_axis_at_the_rapid_feed():
     assert r.motion.pos_mm[y_end, 1] == pytest.approx(10.0, abs=1e-9)
     assert r.motion.pos_mm[y_end - 1, 1] < 10.0 - 1e-6
     assert r.motion.pos_mm[y_end, 0] < 50.0  # X is far from done: the path is not straight
-    linear = simulate(parse("G0 X100 Y10"), MACHINE)
+    linear = simulate(parse("G0 X100 Y10"), MACHINE, CONTROL)
     assert linear.command_end_s[0] == pytest.approx(0.603 + 0.18, abs=1e-12)  # 100.499 mm
 
 
 def test_dwell_stops_the_motion():
-    r = simulate(parse("G1 X10 F600\nG4 X0.5\nG1 X20"), MACHINE)
+    r = simulate(parse("G1 X10 F600\nG4 X0.5\nG1 X20"), MACHINE, CONTROL)
     assert r.cycle_time_s == pytest.approx(1.05 + 0.5 + 1.05, abs=1e-12)
     dwell = r.motion.block == 1
     assert dwell.sum() == 500
     assert np.all(r.motion.speed_mm_s[dwell] == 0.0)
 
 
+def test_feed_is_clamped_to_what_the_axis_velocities_allow():
+    # X at most 5 mm/s: 10 mm along X at F600 (10 mm/s) takes 2 s + AT; at 45 degrees in XY
+    # each axis moves at 1/sqrt(2) of the path speed, so the path runs at 5 sqrt(2) mm/s
+    slow = dataclasses.replace(MACHINE, axis_max_velocity_mm_s=(5.0, 5.0, 200.0))
+    r = simulate(parse("G1 X10 F600"), slow, CONTROL)
+    assert r.cycle_time_s == pytest.approx(2.0 + 0.05, abs=1e-12)
+    assert r.motion.speed_mm_s.max() == pytest.approx(5.0, rel=1e-9)
+    diagonal = simulate(parse("G1 X10 Y10 F600"), slow, CONTROL)
+    assert diagonal.motion.speed_mm_s.max() == pytest.approx(5.0 * math.sqrt(2.0), rel=1e-9)
+    assert np.abs(diagonal.motion.vel_mm_s).max() == pytest.approx(5.0, rel=1e-9)
+
+
 def test_position_loop_lags_by_f_over_kp():
-    r = simulate(parse("G1 X10 F600"), MACHINE)
+    r = simulate(parse("G1 X10 F600"), MACHINE, CONTROL)
     # first-order loop at constant velocity: e = v / Kp = 10 / 80 mm
     assert r.following_error_mm[800, 0] == pytest.approx(10.0 / 80.0, rel=1e-6)
 
 
 def test_inposition_measurement_is_seeded_and_z_is_slowest():
-    a = measure_inposition_times(MACHINE, seed=3)
-    b = measure_inposition_times(MACHINE, seed=3)
+    a = measure_inposition_times(MACHINE, CONTROL, seed=3)
+    b = measure_inposition_times(MACHINE, CONTROL, seed=3)
     np.testing.assert_array_equal(a.samples_s, b.samples_s)
     assert a.samples_s.shape == (3, 5)
     assert a.mean_s[2] > 3 * a.mean_s[0] > 0
@@ -137,17 +153,17 @@ def test_inposition_measurement_is_seeded_and_z_is_slowest():
 )
 def test_time_constants_must_be_whole_periods(changes, message):
     with pytest.raises(ValueError, match=message):
-        simulate(parse("G1 X1 F60"), dataclasses.replace(MACHINE, **changes))
+        simulate(parse("G1 X1 F60"), MACHINE, dataclasses.replace(CONTROL, **changes))
 
 
 def test_bad_arguments_are_named():
     no_feed = dataclasses.replace(parse("G1 X1 F60"), feed_mm_s=np.array([np.nan]))
     with pytest.raises(ValueError, match="feed_mm_s = nan of block 0"):
-        simulate(no_feed, MACHINE)
+        simulate(no_feed, MACHINE, CONTROL)
     with pytest.raises(ValueError, match="repeats = 0 is out of range"):
-        measure_inposition_times(MACHINE, repeats=0)
+        measure_inposition_times(MACHINE, CONTROL, repeats=0)
     with pytest.raises(ValueError, match="rapid_type = 'curved'"):
-        dataclasses.replace(MACHINE, rapid_type="curved")
+        dataclasses.replace(CONTROL, rapid_type="curved")
 
 
 segment = st.tuples(
@@ -185,8 +201,8 @@ def _program(segments) -> tuple[str, float]:
 def test_kernel_ends_at_the_program_end_and_never_exceeds_f(segments, at_s):
     text, fmax = _program(segments)
     tp = parse(text)
-    m = dataclasses.replace(MACHINE, cut_time_constant_s=at_s)
-    motion = run(tp, m)
+    c = dataclasses.replace(CONTROL, cut_time_constant_s=at_s)
+    motion = run(tp, MACHINE, c)
     np.testing.assert_allclose(motion.pos_mm[-1], tp.end_mm[-1], atol=1e-6)
     assert np.all(np.isfinite(motion.pos_mm))
     # arcs written with 4 decimals have start and end radii that differ by up to 1e-4 mm; the
@@ -197,9 +213,9 @@ def test_kernel_ends_at_the_program_end_and_never_exceeds_f(segments, at_s):
 def test_servo_is_the_packages_one_position_loop():
     # the kernel's following error is what nctwin.physics.servo.PositionLoop makes of the
     # command: X with Kp 80, Z with Kp 35, through a rapid, its in-position wait and a line
-    r = simulate(parse("G0 X30 Z-20\nG1 X40 Y5 F1200"), MACHINE)
+    r = simulate(parse("G0 X30 Z-20\nG1 X40 Y5 F1200"), MACHINE, CONTROL)
     cmd = r.motion.pos_mm
-    for axis, kp in enumerate(MACHINE.position_gain_per_s):
+    for axis, kp in enumerate(CONTROL.position_gain_per_s):
         actual = PositionLoop("first_order_ff", kp).follow(cmd[:, axis], TI)
         np.testing.assert_allclose(r.following_error_mm[:, axis], cmd[:, axis] - actual,
                                    atol=1e-12)  # fmt: skip

@@ -18,9 +18,10 @@ from nctwin.estimate.blend_junctions import (
     parabolic_performance,
 )
 from nctwin.gcode import parse
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 
-MACHINE = load_machine("linuxcnc_sim")
+PROFILE = load_profile("linuxcnc_sim")
+MACHINE = PROFILE.machine
 A_N = math.sqrt(0.75) * 1000.0  # normal acceleration of a blend arc in XY
 R = 5.0  # the arc's radius
 KINK = math.radians(1.0)
@@ -139,4 +140,4 @@ def test_arc_into_a_kinked_short_line_runs_through_the_tiny_blend_arc(program, r
     if "G19" in program:
         start = "G21 G90 G64 P0.0254 Q0\nG0 Y-5 Z5\nG1 F12000\n"
     tp = parse(start + program + "M2\n", start_mm=(0, 0, 0))
-    assert estimate(tp, MACHINE, "planner").cycle_time_s == pytest.approx(recorded_s, abs=0.002)
+    assert estimate(tp, PROFILE, "planner").cycle_time_s == pytest.approx(recorded_s, abs=0.002)

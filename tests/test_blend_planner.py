@@ -22,19 +22,21 @@ from nctwin.estimate.blend_planner import (
 )
 from nctwin.estimate.blend_speeds import OPTIMIZATION_DEPTH, optimised_end_speeds, stops_on_periods
 from nctwin.gcode import parse
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 
-MACHINE = load_machine("linuxcnc_sim")  # X/Y 1000 mm/s^2, Z 500 mm/s^2, 1 ms
+PROFILE = load_profile("linuxcnc_sim")
+MACHINE = PROFILE.machine  # X/Y 1000 mm/s^2, Z 500 mm/s^2
+PLANNER = PROFILE.control("planner")  # 1 ms, G64 P0.0254
 A = 1000.0  # path acceleration along X or Y
 AXIS_ACC = np.array([1000.0, 1000.0, 500.0])
 
 
 def time_s(program: str) -> float:
-    return estimate(parse(program, start_mm=(0, 0, 0)), MACHINE, "planner").cycle_time_s
+    return estimate(parse(program, start_mm=(0, 0, 0)), PROFILE, "planner").cycle_time_s
 
 
 def estimate_planner(tp, **kwargs):
-    return blend_planner(tp, MACHINE, **kwargs)
+    return blend_planner(tp, MACHINE, PLANNER, **kwargs)
 
 
 def whole_periods(t: float) -> float:
@@ -220,7 +222,7 @@ def test_an_arc_entered_from_outside_its_plane_gets_a_parabolic_blend():
     program = "G21 G90 G64 P0.1\nG0 X50 Y40 Z0\nG1 Y50 F6000\nG18 G2 X55 Z5 I5 K0\nG1 X45\n"
     tp = parse(program, start_mm=(0, 0, 0))
     moves = tp.take(np.arange(1, 4))
-    tol = moves.effective_tolerance_mm(MACHINE.blend_tol_mm)
+    tol = moves.effective_tolerance_mm(PLANNER.blend_tol_mm)
     np.testing.assert_array_equal(parabolic_junctions(moves, tol), [True, False])
     feed, acc = move_limits(moves, MACHINE, np.array([0.5, 0.5, 1.0]))
     assert feed[1] == pytest.approx(math.sqrt(NORMAL_ACC_RATIO * 250 * 5))
@@ -234,14 +236,14 @@ def test_tangent_junction_by_hand():
     # (60 / 0.001 + 1000) * |u2 - u1| / 1000 = 61 * 0.001 = 0.061 of X's or Y's acceleration
     tp = parse("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n", start_mm=(0, 0, 0))
     feed, acc = move_limits(tp, MACHINE)
-    tangent, share = tangent_junctions(tp, feed, acc, AXIS_ACC, MACHINE.period_s)
+    tangent, share = tangent_junctions(tp, feed, acc, AXIS_ACC, PLANNER.period_s)
     turn = math.atan2(0.01, 10.0)
     assert share[0] == pytest.approx(61.0 * turn, rel=1e-6)  # Y's component dominates
     assert tangent[0] and share[0] < KINK_RATIO
     # a turn twice as sharp, at twice the speed, is no longer tangent
     tp2 = parse("G21 G90 G61\nG1 X10 F7200\nX20 Y0.02\n", start_mm=(0, 0, 0))
     feed2, acc2 = move_limits(tp2, MACHINE)
-    assert not tangent_junctions(tp2, feed2, acc2, AXIS_ACC, MACHINE.period_s)[0][0]
+    assert not tangent_junctions(tp2, feed2, acc2, AXIS_ACC, PLANNER.period_s)[0][0]
     # tangent: no stop, both lines at (1 - share) a; the last keeps its exact-path end (no a/2)
     a = A * (1 - share[0])
     total = trapezoid_s(10.0, 60.0, a, v1=60.0) + trapezoid_s(math.hypot(10, 0.01), 60.0, a, 60.0)

@@ -10,15 +10,16 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from test_accdec import MACHINE, _program, segment
+from test_accdec import CONTROL, MACHINE, _program, segment
 
 from nctwin import parse
 from nctwin.estimate import METHODS, estimate
 from nctwin.estimate.block_overlap import block_overlap
 from nctwin.kernel.accdec import simulate
+from nctwin.machine import Profile
 from nctwin.methods.lee2022 import block_times
 
-TI = MACHINE.period_s  # 1 ms
+TI = CONTROL.period_s  # 1 ms
 AT, ATR, AS = 0.05, 0.15, 0.03
 FR = MACHINE.rapid_feed_mm_s
 INPOS = (0.025, 0.025, 0.12)
@@ -29,7 +30,7 @@ def ceil_ti(t):
 
 
 def est(text, **kw):
-    return block_overlap(parse(text), MACHINE, inposition_s=INPOS, **kw)
+    return block_overlap(parse(text), MACHINE, CONTROL, inposition_s=INPOS, **kw)
 
 
 def test_one_normal_block():
@@ -41,15 +42,15 @@ def test_one_normal_block():
 
 def test_one_short_cutting_block():
     # eq. 4-5: 0.3 mm at 10 mm/s: Tb = AT, Ta = ceilTI(0.03 s); T = 80 ms
-    bt = block_times(parse("G1 X0.3 F600"), MACHINE)
+    bt = block_times(parse("G1 X0.3 F600"), MACHINE, CONTROL)
     assert bt["short"][0]
     assert bt["T"][0] == pytest.approx(0.05 + 0.03, abs=1e-12)
 
 
 def test_one_short_rapid_without_bell():
     # eq. 9-11: a = Fr / ATR; 2 mm: sqrt(2 / 1111.1) = 42.43 ms -> 43 ms; T = 2 Ta = 86 ms
-    m = dataclasses.replace(MACHINE, rapid_bell_s=0.0)
-    e = block_overlap(parse("G0 X2"), m, inposition=False)
+    c = dataclasses.replace(CONTROL, rapid_bell_s=0.0)
+    e = block_overlap(parse("G0 X2"), MACHINE, c, inposition=False)
     a = FR / ATR
     assert e.cycle_time_s == pytest.approx(2 * ceil_ti(math.sqrt(2 / a)), abs=1e-12)
     assert e.cycle_time_s == pytest.approx(0.086, abs=1e-12)
@@ -60,8 +61,8 @@ def test_short_rapid_with_bell_and_normal_rapids():
     assert est("G0 X2", inposition=False).cycle_time_s == pytest.approx(0.086 + AS, abs=1e-12)
     assert est("G0 X100", inposition=False).cycle_time_s == pytest.approx(0.78, abs=1e-12)
     # eq. 14, non-linear type: the longest axis travel (100 mm) instead of the 100.499 mm line
-    nonlinear = dataclasses.replace(MACHINE, rapid_type="nonlinear")
-    e = block_overlap(parse("G0 X100 Y10"), nonlinear, inposition=False)
+    nonlinear = dataclasses.replace(CONTROL, rapid_type="nonlinear")
+    e = block_overlap(parse("G0 X100 Y10"), MACHINE, nonlinear, inposition=False)
     assert e.cycle_time_s == pytest.approx(0.6 + ATR + AS, abs=1e-12)
     assert est("G0 X100 Y10", inposition=False).cycle_time_s == pytest.approx(0.783, abs=1e-12)
 
@@ -97,26 +98,26 @@ def test_inposition_of_the_slowest_moving_axis():
     assert est("G0 X100 Z-10").cycle_time_s == pytest.approx(bare + 0.12, abs=1e-12)
     bare = est("G0 X100 Y5", inposition=False).cycle_time_s
     assert est("G0 X100 Y5").cycle_time_s == pytest.approx(bare + 0.025, abs=1e-12)
-    # the machine's own table is the default
-    m = dataclasses.replace(MACHINE, inposition_time_s=(0.0, 0.0, 0.2))
-    assert block_overlap(parse("G0 Z5"), m).cycle_time_s == pytest.approx(
-        block_overlap(parse("G0 Z5"), m, inposition=False).cycle_time_s + 0.2
+    # the control's own table is the default
+    c = dataclasses.replace(CONTROL, inposition_time_s=(0.0, 0.0, 0.2))
+    assert block_overlap(parse("G0 Z5"), MACHINE, c).cycle_time_s == pytest.approx(
+        block_overlap(parse("G0 Z5"), MACHINE, c, inposition=False).cycle_time_s + 0.2
     )
 
 
 def test_registered_as_a_method():
     assert "block_overlap" in METHODS
-    e = estimate(parse("G1 X10 F600"), MACHINE, "block_overlap")
-    assert e.method == "block_overlap"
+    # on a profile, the method runs on its [control.accdec] table
+    e = estimate(parse("G1 X10 F600"), Profile(MACHINE, accdec=CONTROL), "block_overlap")
+    assert e.method == "block_overlap" and e.machine == "hand"
     assert e.cycle_time_s == pytest.approx(1.05)
 
 
 def test_bad_parameters_are_named():
     with pytest.raises(ValueError, match=r"inposition_s = .* is out of range"):
-        block_overlap(parse("G0 X1"), MACHINE, inposition_s=(0.1, -0.1, 0.1))
-    bad = dataclasses.replace(MACHINE, cut_time_constant_s=0.0505)
+        block_overlap(parse("G0 X1"), MACHINE, CONTROL, inposition_s=(0.1, -0.1, 0.1))
     with pytest.raises(ValueError, match=r"cut_time_constant_s = 0\.0505 is out of range"):
-        block_overlap(parse("G1 X1 F60"), bad)
+        dataclasses.replace(CONTROL, cut_time_constant_s=0.0505)  # not a whole period
 
 
 @given(
@@ -140,9 +141,9 @@ def test_estimator_agrees_with_kernel_within_one_period_per_block(items, at_s):
     # each chunk of segments starts from the origin in _program; join them with a G1 back there
     text = "\nG1 X0 Y0 Z0 F600\n".join(chunks)
     tp = parse(text)
-    m = dataclasses.replace(MACHINE, cut_time_constant_s=at_s)
-    measured = simulate(tp, m)
-    predicted = block_overlap(tp, m)
+    c = dataclasses.replace(CONTROL, cut_time_constant_s=at_s)
+    measured = simulate(tp, MACHINE, c)
+    predicted = block_overlap(tp, MACHINE, c)
     per_block = np.abs(measured.block_times_s - predicted.block_times_s)
     assert per_block.max() <= TI * (1 + 1e-6)
     assert abs(measured.cycle_time_s - predicted.cycle_time_s) <= len(tp) * TI * (1 + 1e-6)

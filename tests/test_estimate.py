@@ -8,9 +8,9 @@ import pytest
 
 from nctwin import parse
 from nctwin.estimate import estimate
-from nctwin.machine import MachineProfile
+from nctwin.machine import Machine, Profile
 
-MACHINE = MachineProfile(
+MACHINE = Machine(
     name="hand",
     description="round numbers",
     axis_max_velocity_mm_s=(500.0, 500.0, 500.0),
@@ -19,6 +19,7 @@ MACHINE = MachineProfile(
     rapid_feed_mm_s=500.0,
     max_feed_mm_s=1000.0,
 )
+PROFILE = Profile(MACHINE)  # CAM needs no control
 
 PROGRAM = """
 G21 G90 G17
@@ -32,7 +33,7 @@ M30
 
 
 def test_cam_time_of_a_hand_computed_program():
-    result = estimate(parse(PROGRAM), MACHINE, "cam")
+    result = estimate(parse(PROGRAM), PROFILE, "cam")
     expected = 0.02 + 1.0 + 3.0 + math.pi / 2 + 2.0
     assert result.cycle_time_s == pytest.approx(expected, rel=1e-12)
     by_kind = result.by_kind()
@@ -45,20 +46,20 @@ def test_cam_time_of_a_hand_computed_program():
 
 
 def test_cam_clamps_feed_to_the_machine_maximum():
-    result = estimate(parse("G1 X100 F120000"), MACHINE, "cam")  # 2000 mm/s asked, 1000 allowed
+    result = estimate(parse("G1 X100 F120000"), PROFILE, "cam")  # 2000 mm/s asked, 1000 allowed
     assert result.cycle_time_s == pytest.approx(0.1)
 
 
 def test_inch_program_time():
     # 1 in at 60 in/min takes 1 s whatever the units
-    result = estimate(parse("G20\nG1 X1 F60"), MACHINE, "cam")
+    result = estimate(parse("G20\nG1 X1 F60"), PROFILE, "cam")
     assert result.cycle_time_s == pytest.approx(1.0)
     # on one line LinuxCNC sets F (60 mm/min, the program starts in mm) before it changes the
     # units, and keeps the physical feed: 25.4 mm at 60 mm/min take 25.4 s
-    result = estimate(parse("G20 G1 X1 F60"), MACHINE, "cam")
+    result = estimate(parse("G20 G1 X1 F60"), PROFILE, "cam")
     assert result.cycle_time_s == pytest.approx(25.4)
 
 
 def test_unknown_method_is_named():
     with pytest.raises(ValueError, match="method = 'magic' is unknown: allowed cam"):
-        estimate(parse("G1 X1 F60"), MACHINE, "magic")
+        estimate(parse("G1 X1 F60"), PROFILE, "magic")

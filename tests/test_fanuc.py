@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -11,15 +12,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_accdec import MACHINE
 
+from nctwin.controls import FanucControl
 from nctwin.gcode import parse
 from nctwin.kernel.fanuc import (
     PAPER_SET_1,
     PAPER_SET_2,
-    FanucSettings,
     measure_inposition_times,
     run,
     simulate,
 )
+from nctwin.machine import Profile, load_profile
 from nctwin.motion import Motion
 from nctwin.paths import data_dir
 from nctwin.toolpath import MotionKind, Toolpath
@@ -28,8 +30,8 @@ TI = 0.001
 FR = 10000.0 / 60.0  # the paper's rapid feed, mm/s
 A_RAPID = FR / 0.15  # rapid acceleration of set 1, mm/s^2
 
-# the paper's rapid feed; the kernel reads only rapid_feed_mm_s and max_feed_mm_s of the machine,
-# every control parameter is in FanucSettings
+# the paper's rapid feed; the kernel reads rapid_feed_mm_s, max_feed_mm_s and the axis velocities
+# of the machine, every control parameter is in FanucControl
 assert MACHINE.rapid_feed_mm_s == MACHINE.max_feed_mm_s == FR
 
 
@@ -126,6 +128,17 @@ def test_short_blocks_run_at_l_over_block_time():
     assert sim("G91 G1 X0.05 F3000\n" + "X0.05\n" * 99, block_time_s=0.0).cycle_time_s < (
         r.cycle_time_s
     )
+
+
+def test_feed_is_clamped_to_what_the_axis_velocities_allow():
+    # X and Y at most 5 mm/s: along X at F600 (10 mm/s) the block runs at 5 mm/s; at 45 degrees
+    # in XY each axis moves at 1/sqrt(2) of the path speed, so the path runs at 5 sqrt(2) mm/s
+    slow = dataclasses.replace(MACHINE, axis_max_velocity_mm_s=(5.0, 5.0, 200.0))
+    r = simulate(parse("G1 X10 F600\nG1 X20 Y10"), slow, PAPER_SET_1)
+    np.testing.assert_allclose(r.block_feed_mm_s, [5.0, 5.0 * math.sqrt(2.0)], rtol=1e-12)
+    assert np.abs(np.diff(r.command_mm, axis=0)).max() / TI <= 5.0 * (1 + 1e-9)
+    # the paper's machine allows more than the feed: the programmed F
+    assert sim("G1 X10 F600").block_feed_mm_s[0] == 10.0
 
 
 def test_feed_never_exceeds_f():
@@ -264,7 +277,7 @@ def test_empty_program():
 
 
 _RANGE = "is out of range: allowed"
-_WHOLE = ".* whole multiples of interp_period_s"
+_WHOLE = ".* whole multiples of period_s"
 
 
 @pytest.mark.parametrize(
@@ -273,7 +286,7 @@ _WHOLE = ".* whole multiples of interp_period_s"
         ({"cut_time_constant_s": -0.1}, rf"cut_time_constant_s = -0.1 {_RANGE} \(0, 10\]"),
         ({"rapid_time_constant_s": 0.0}, rf"rapid_time_constant_s = 0.0 {_RANGE} \(0, 10\]"),
         ({"cut_time_constant_s": 0.0505}, rf"cut_time_constant_s = 0.0505 {_WHOLE}"),
-        ({"interp_period_s": 0.004}, rf"cut_time_constant_s = 0.05 {_WHOLE} = 0.004"),
+        ({"period_s": 0.004}, rf"cut_time_constant_s = 0.05 {_WHOLE} = 0.004"),
         ({"rapid_bell_s": 0.0305}, rf"rapid_bell_s = 0.0305 {_WHOLE}"),
         ({"cut_accdec": "bell", "cut_time_constant_s": 0.051}, r"even multiples"),
         ({"inposition_width_mm": (0.02, 0.0, 0.02)}, rf"inposition_width_mm\[Y\] = 0.0 {_RANGE}"),
@@ -283,12 +296,12 @@ _WHOLE = ".* whole multiples of interp_period_s"
         ({"feedforward": 1.5}, rf"feedforward = 1.5 {_RANGE} \[0, 1\]"),
         ({"block_time_s": -0.001}, rf"block_time_s = -0.001 {_RANGE} \[0, 1\)"),
         ({"rapid_overlap": 1}, r"rapid_overlap = 1"),
-        ({"interp_period_s": 0.0}, rf"interp_period_s = 0.0 {_RANGE} \(0, 0.1\]"),
+        ({"period_s": 0.0}, rf"period_s = 0.0 {_RANGE} \(0, 0.1\]"),
     ],
 )
 def test_settings_are_checked(changes, message):
     with pytest.raises(ValueError, match=message):
-        FanucSettings(**changes)
+        FanucControl(**changes)
 
 
 def _one_block(kind: MotionKind, end, feed: float, start=(0.0, 0.0, 0.0)) -> Toolpath:
@@ -367,14 +380,15 @@ def test_random_programs_end_on_the_program_end(text, accdec):
 
 
 def test_settings_load_from_the_profiles_table(tmp_path):
-    assert FanucSettings.load("fanuc_0i_testbed") == PAPER_SET_1
+    assert load_profile("fanuc_0i_testbed").fanuc == PAPER_SET_1
     own = tmp_path / "own.toml"
     base = (data_dir() / "machines" / "fanuc_0i_testbed.toml").read_text()
     own.write_text(base.replace("block_time_s = 0.004", "block_time_s = 0.002"))
-    assert FanucSettings.load(own).block_time_s == 0.002
+    assert Profile.from_toml(own).fanuc.block_time_s == 0.002
+    where = rf"^{re.escape(str(own))}: \[control\.fanuc\] "
     own.write_text(base.replace("block_time_s = 0.004", "block_time_ms = 4"))
-    with pytest.raises(ValueError, match=r"unexpected keyword argument 'block_time_ms'"):
-        FanucSettings.load(own)
+    with pytest.raises(ValueError, match=rf"{where}unknown key\(s\) block_time_ms;"):
+        Profile.from_toml(own)
     own.write_text(base.replace("inposition_width_mm = [0.02", "inposition_width_mm = [0.0"))
-    with pytest.raises(ValueError, match=r"inposition_width_mm\[X\] = 0\.0 is out of range"):
-        FanucSettings.load(own)
+    with pytest.raises(ValueError, match=rf"{where}inposition_width_mm\[X\] = 0\.0 is out of"):
+        Profile.from_toml(own)

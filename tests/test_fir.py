@@ -12,10 +12,11 @@ from hypothesis import strategies as st
 
 from nctwin import parse
 from nctwin.kernel import fir
-from nctwin.machine import MachineProfile
+from nctwin.controls import FirControl
+from nctwin.machine import Machine
 from nctwin.targets import block_targets
 
-MACHINE = MachineProfile(
+MACHINE = Machine(
     name="fir-test",
     description="round numbers, limits far from the tests' feeds",
     axis_max_velocity_mm_s=(1000.0, 1000.0, 1000.0),
@@ -23,11 +24,10 @@ MACHINE = MachineProfile(
     axis_max_jerk_mm_s3=(1e9, 1e9, 1e9),
     rapid_feed_mm_s=500.0,
     max_feed_mm_s=1000.0,
-    period_s=0.001,
-    blend_tol_mm=0.05,
 )
-SETTINGS = fir.FirSettings(t1_s=0.05, t2_s=0.01)
-FILTER = fir.FirFilter.of(SETTINGS, MACHINE.period_s)
+SETTINGS = FirControl(period_s=0.001, blend_tol_mm=0.05, t1_s=0.05, t2_s=0.01)
+FILTER = fir.FirFilter.of(SETTINGS)
+PERIOD_S = SETTINGS.period_s
 
 
 def _corner_distance(pos: np.ndarray, corner) -> float:
@@ -43,7 +43,7 @@ def test_straight_line_takes_l_over_f_plus_t1_plus_t2():
     feed, length = 80.0, 120.0
     motion = fir.run(parse(f"G1 X{length} F{feed * 60}"), MACHINE, SETTINGS)
     expected = length / feed + SETTINGS.t1_s + SETTINGS.t2_s
-    assert motion.cycle_time_s == pytest.approx(expected, abs=MACHINE.period_s)
+    assert motion.cycle_time_s == pytest.approx(expected, abs=PERIOD_S)
     np.testing.assert_array_equal(motion.pos_mm[0], [0, 0, 0])
     np.testing.assert_array_equal(motion.pos_mm[-1], [length, 0, 0])
     assert motion.speed_mm_s.max() == pytest.approx(feed, rel=1e-9)
@@ -51,7 +51,7 @@ def test_straight_line_takes_l_over_f_plus_t1_plus_t2():
     acc = np.abs(motion.acc_mm_s2[:, 0]).max()
     jerk = np.abs(motion.jerk_mm_s3[:, 0]).max()
     assert acc <= feed / SETTINGS.t1_s * (1 + 1e-6)
-    assert acc == pytest.approx(feed / (SETTINGS.t1_s + MACHINE.period_s), rel=1e-6)
+    assert acc == pytest.approx(feed / (SETTINGS.t1_s + PERIOD_S), rel=1e-6)
     assert jerk <= feed / (SETTINGS.t1_s * SETTINGS.t2_s) * (1 + 1e-6)
 
 
@@ -95,11 +95,11 @@ def test_corner_without_reduction_matches_the_closed_form():
     # tolerance far above the deviation: the corner is passed at the programmed feed
     feed = 40.0
     tp = parse(f"G64 P5 G1 X50 F{feed * 60}\nY50")
-    assert fir.plan(tp, MACHINE, FILTER).junction_mm_s[1] == pytest.approx(feed)
+    assert fir.plan(tp, MACHINE, SETTINGS).junction_mm_s[1] == pytest.approx(feed)
     d = _corner_distance(fir.run(tp, MACHINE, SETTINGS).pos_mm, np.array([50.0, 0, 0]))
     # the sampled boxes average n = T/Ts + 1 samples: their continuous twins are n Ts long
     n1, n2 = FILTER.taps
-    ts = MACHINE.period_s
+    ts = PERIOD_S
     closed = fir.corner_deviation_mm(feed, math.pi / 2, n1 * ts, n2 * ts)
     assert d == pytest.approx(closed, rel=2e-3)
     assert closed == pytest.approx(
@@ -115,7 +115,7 @@ def test_reduced_corner_is_within_tolerance_at_the_highest_feed(angle_deg):
     end = corner + 50.0 * np.array([math.cos(a), math.sin(a), 0.0])
     program = f"G1 X50 F{feed * 60}\nX{end[0]:.9f} Y{end[1]:.9f}"
     tp = parse(f"G64 P{tol}\n{program}")
-    v = fir.plan(tp, MACHINE, FILTER).junction_mm_s[1]
+    v = fir.plan(tp, MACHINE, SETTINGS).junction_mm_s[1]
     assert 0 < v < feed  # reduced
     assert _corner_distance(fir.run(tp, MACHINE, SETTINGS).pos_mm, corner) <= tol
     # one percent faster through the same corner breaks the tolerance
@@ -131,10 +131,10 @@ def test_exact_stop_and_dwell():
     at_corner = np.linalg.norm(motion.pos_mm - [10, 0, 0], axis=1) < 1e-9
     assert at_corner.any() and (motion.speed_mm_s[at_corner][1:] == 0).all()
     dwell = np.linalg.norm(motion.pos_mm - [10, 10, 0], axis=1) < 1e-9
-    assert dwell.sum() * MACHINE.period_s >= 0.5
+    assert dwell.sum() * PERIOD_S >= 0.5
     assert len(stops) > 0
     targets = block_targets(motion, tp)
-    assert targets.time_s[2] == pytest.approx(0.5, abs=2 * MACHINE.period_s)
+    assert targets.time_s[2] == pytest.approx(0.5, abs=2 * PERIOD_S)
     assert targets.cycle_time_s == pytest.approx(motion.cycle_time_s)
 
 
@@ -161,7 +161,7 @@ def test_zigzag_dips_at_every_corner():
     tp = parse(
         "G64 P0.05\nF%g\n" % (feed * 60) + "\n".join(f"G1 X{x:.6f} Y{y:.6f}" for x, y in pts)
     )
-    plan = fir.plan(tp, MACHINE, FILTER)
+    plan = fir.plan(tp, MACHINE, SETTINGS)
     assert (plan.junction_mm_s[1:n] < 0.5 * feed).all()
     motion = fir.run(tp, MACHINE, SETTINGS)
     targets = block_targets(motion, tp)
@@ -176,9 +176,10 @@ def test_kernel_cycle_time_exceeds_cam():
 
 
 def test_bad_filter_constants_are_named():
-    slow = fir.FirSettings(t1_s=0.0, t2_s=0.0)
+    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range: allowed \[period_s, 10\]"):
+        FirControl(t1_s=0.0, t2_s=0.0)
     with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range for the FIR kernel"):
-        fir.run(parse("G1 X1 F60"), MACHINE, slow)
+        fir.FirFilter(0.0, 0.0, 0.001)
 
 
 # ------------------------------------------------------------------------------ properties
@@ -232,13 +233,12 @@ def test_kernel_invariants(program):
 
 def test_arc_feed_is_limited_by_centripetal_acceleration():
     # r = 5 mm, A = 2000 mm/s^2 on X and Y: at most sqrt(A r) = 100 mm/s on the arc
-    tight = dataclasses.replace(
-        MACHINE, axis_max_acceleration_mm_s2=(2000.0, 2000.0, 2000.0), blend_tol_mm=10.0
-    )
+    tight = dataclasses.replace(MACHINE, axis_max_acceleration_mm_s2=(2000.0, 2000.0, 2000.0))
+    loose = dataclasses.replace(SETTINGS, blend_tol_mm=10.0)
     tp = parse("G0 X5 Y0\nG3 X5 Y0 I-5 J0 F30000")
     v_arc = math.sqrt(2000.0 * 5.0)
-    assert fir.plan(tp, tight, FILTER).feed_mm_s[1] == pytest.approx(v_arc)
-    motion = fir.run(tp, tight, SETTINGS)
+    assert fir.plan(tp, tight, loose).feed_mm_s[1] == pytest.approx(v_arc)
+    motion = fir.run(tp, tight, loose)
     on_arc = motion.block == 1
     assert motion.speed_mm_s[on_arc].max() <= v_arc * (1 + 1e-9)
     # the tool stays on the circle within the filter's shrinkage

@@ -9,7 +9,7 @@ import pytest
 
 from nctwin import MotionKind, parse_file
 from nctwin.estimate import estimate
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.programs import iso10791 as iso
 from nctwin.programs.iso10791 import TestPieceParams, shipped_test_piece_path
 
@@ -26,7 +26,7 @@ def test_program_has_every_kind_of_block_at_its_natural_length():
     assert counts["arc_cw"] == p.repeats * p.passes * 4 * 4  # circle quadrants + 3 x 4 corners
     assert counts["rapid"] == 15 * 3 + 3 and counts["linear"] == 306  # 3 per pass, 3 at the ends
     # one sequence, not repeated: CAM's length / feed is 7-8 minutes
-    assert 420.0 < estimate(tp, load_machine("fanuc_0i_testbed"), "cam").cycle_time_s < 480.0
+    assert 420.0 < estimate(tp, load_profile("fanuc_0i_testbed"), "cam").cycle_time_s < 480.0
 
 
 def _arcs_at(tp, z):

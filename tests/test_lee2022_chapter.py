@@ -11,8 +11,10 @@ import pytest
 
 from nctwin import parse
 from nctwin.chapters import lee2022 as lee
+from nctwin.controls import FanucControl
 from nctwin.estimate.block_overlap import block_overlap
 from nctwin.kernel import fanuc
+from nctwin.machine import load_machine, load_profile
 from nctwin.methods.lee2022 import check_program
 from nctwin.paths import data_dir
 from nctwin.recordings import load_recordings
@@ -20,9 +22,10 @@ from nctwin.report.tables import load_paper_table
 
 PAPER = load_paper_table("lee2022_validation")
 SETS = lee.parameter_sets("fanuc_0i_testbed", PAPER)
+MACHINE = load_machine("fanuc_0i_testbed")
 
 
-def truth_with(effect: str, s: int = 1) -> fanuc.FanucSettings:
+def truth_with(effect: str, s: int = 1) -> FanucControl:
     return lee._effect_settings(SETS[s][1], lee.EFFECTS[effect])
 
 
@@ -46,8 +49,10 @@ def test_parameter_sets_are_the_papers():
     for s, want in ((1, (0.15, 0.03, 0.05)), (2, (0.1, 0.02, 0.1))):
         for c in SETS[s]:
             assert (c.rapid_time_constant_s, c.rapid_bell_s, c.cut_time_constant_s) == want
-    # the profile's [fanuc] table is the testbed the defaults describe
+    # the profile's [control.fanuc] table is the testbed the defaults describe, its
+    # [control.accdec] table the estimator's set 1
     assert SETS[1][1] == fanuc.PAPER_SET_1 and SETS[2][1] == fanuc.PAPER_SET_2
+    assert SETS[1][0] == load_profile("fanuc_0i_testbed").accdec
 
 
 def test_the_estimators_model_switches_every_effect_off():
@@ -65,9 +70,9 @@ def test_the_estimators_model_switches_every_effect_off():
 
 def _both(text: str, effect: str) -> tuple[float, float]:
     tp = parse(text)
-    m = SETS[1][0]
-    truth = fanuc.simulate(tp, m, truth_with(effect)).cycle_time_s
-    return truth, block_overlap(tp, m, inposition_s=(0.0, 0.0, 0.0)).cycle_time_s
+    truth = fanuc.simulate(tp, MACHINE, truth_with(effect)).cycle_time_s
+    model = SETS[1][0]
+    return truth, block_overlap(tp, MACHINE, model, inposition_s=(0.0, 0.0, 0.0)).cycle_time_s
 
 
 def test_arc_clamp_is_what_the_estimator_misses_on_a_lead_arc():

@@ -17,10 +17,11 @@ import pytest
 from nctwin.estimate import estimate
 from nctwin.gcode import parse
 from nctwin.kernel import linuxcnc as lc
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 
-MACHINE = load_machine("linuxcnc_sim")
-PERIOD_S = MACHINE.period_s
+PROFILE = load_profile("linuxcnc_sim")
+MACHINE, PLANNER = PROFILE.machine, PROFILE.control("planner")
+PERIOD_S = PLANNER.period_s
 #: halsampler prints positions with 6 decimals (1 nm): speeds from differences carry up to
 #: 2e-6 mm / 1 ms of rounding.
 SPEED_ROUNDING_MM_S = 2e-6 / PERIOD_S
@@ -44,7 +45,7 @@ def _ini_values(text: str) -> dict[tuple[str, str], str]:
 
 
 def test_ini_holds_the_profile_limits():
-    ini = _ini_values(lc.ini_text(MACHINE))
+    ini = _ini_values(lc.ini_text(MACHINE, PLANNER))
     for i, axis in enumerate("XYZ"):
         for section in (f"AXIS_{axis}", f"JOINT_{i}"):
             v = float(ini[section, "MAX_VELOCITY"])
@@ -65,26 +66,26 @@ def test_profile_linuxcnc_cannot_follow_is_rejected():
     from dataclasses import replace
 
     with pytest.raises(ValueError, match="axis_max_jerk_mm_s3"):
-        lc.ini_text(replace(MACHINE, axis_max_jerk_mm_s3=(1e4, 1e4, 1e4)))
+        lc.ini_text(replace(MACHINE, axis_max_jerk_mm_s3=(1e4, 1e4, 1e4)), PLANNER)
     with pytest.raises(ValueError, match="rapid_feed_mm_s"):
-        lc.ini_text(replace(MACHINE, rapid_feed_mm_s=100.0))
+        lc.ini_text(replace(MACHINE, rapid_feed_mm_s=100.0), PLANNER)
 
 
 @pytest.mark.parametrize(("kw", "name"), [({"speed": 50}, "speed"), ({"timeout_s": 0}, "timeout")])
 def test_bad_run_arguments(kw, name):
     with pytest.raises(ValueError, match=name):
-        lc.record(LINE, MACHINE, **kw)
+        lc.record(LINE, MACHINE, PLANNER, **kw)
 
 
 def test_program_without_motion_needs_no_linuxcnc():
-    m = lc.run("G21 G90\nG1 X0 F600\nM2\n", MACHINE)
+    m = lc.run("G21 G90\nG1 X0 F600\nM2\n", MACHINE, PLANNER)
     assert len(m) == 1 and m.cycle_time_s == 0.0
     np.testing.assert_array_equal(m.pos_mm, [[0.0, 0.0, 0.0]])
 
 
 @live
 def test_straight_line_duration_end_and_feed():
-    m = lc.run(LINE, MACHINE)
+    m = lc.run(LINE, MACHINE, PLANNER)
     length_mm, feed_mm_s, acc_mm_s2 = 60.0, 50.0, 1000.0
     expected_s = length_mm / feed_mm_s + feed_mm_s / acc_mm_s2  # 1.25 s
     assert abs(m.cycle_time_s - expected_s) <= 3 * PERIOD_S
@@ -101,8 +102,8 @@ def test_straight_line_duration_end_and_feed():
 @live
 def test_trace_does_not_depend_on_wall_clock_time():
     """Blended corners need the planner's look-ahead: x1 equals x5, bit for bit."""
-    fast = lc.run(BLENDED, MACHINE, speed=5)
-    slow = lc.run(BLENDED, MACHINE, speed=1)
+    fast = lc.run(BLENDED, MACHINE, PLANNER, speed=5)
+    slow = lc.run(BLENDED, MACHINE, PLANNER, speed=1)
     np.testing.assert_array_equal(slow.pos_mm, fast.pos_mm)
     np.testing.assert_array_equal(slow.block, fast.block)
     assert fast.block[-1] == 3 and (np.diff(fast.block) >= 0).all()
@@ -114,7 +115,7 @@ def test_parallel_instances_do_not_interfere():
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(3) as pool:
-        line, a, b = pool.map(lambda p: lc.run(p, MACHINE), [LINE, BLENDED, BLENDED])
+        line, a, b = pool.map(lambda p: lc.run(p, MACHINE, PLANNER), [LINE, BLENDED, BLENDED])
     np.testing.assert_array_equal(a.pos_mm, b.pos_mm)
     assert abs(line.cycle_time_s - (60.0 / 50.0 + 50.0 / 1000.0)) <= 3 * PERIOD_S
     np.testing.assert_array_equal(line.pos_mm[-1], [60.0, 0.0, 0.0])
@@ -129,7 +130,7 @@ def test_program_longer_than_the_planner_queue():
     xy = np.round(20.0 * np.column_stack([np.sin(phi), 1.0 - np.cos(phi)]), 4)
     program = "G21 G90 G64 P0.01 Q0\nG1 F6000\n" + "".join(f"X{x} Y{y}\n" for x, y in xy)
     with ThreadPoolExecutor(2) as pool:
-        a, b = pool.map(lambda p: lc.run(p, MACHINE), [program, program])
+        a, b = pool.map(lambda p: lc.run(p, MACHINE, PLANNER), [program, program])
     np.testing.assert_array_equal(a.pos_mm, b.pos_mm)
     np.testing.assert_array_equal(a.pos_mm[-1], [xy[-1, 0], xy[-1, 1], 0.0])
     assert a.block[-1] == len(xy) - 1
@@ -140,7 +141,7 @@ def test_program_longer_than_the_planner_queue():
 @live
 def test_exact_stop_at_corner():
     tp = parse(CORNER)
-    m = lc.run(tp, MACHINE)
+    m = lc.run(tp, MACHINE, PLANNER)
     corner = np.flatnonzero((m.pos_mm[:, 0] == 30.0) & (m.pos_mm[:, 1] == 0.0))
     assert len(corner) >= 1  # the tool reaches the corner itself: no blend
     k = corner[0]
@@ -231,15 +232,15 @@ PLANNER_PROGRAMS = {
 @pytest.mark.parametrize("name", sorted(PLANNER_PROGRAMS))
 def test_blend_planner_times_what_linuxcnc_records(name):
     program = PLANNER_PROGRAMS[name]
-    recorded = lc.run(program, MACHINE).cycle_time_s
-    planned = estimate(parse(program, start_mm=(0, 0, 0)), MACHINE, "planner").cycle_time_s
+    recorded = lc.run(program, MACHINE, PLANNER).cycle_time_s
+    planned = estimate(parse(program, start_mm=(0, 0, 0)), PROFILE, "planner").cycle_time_s
     assert planned == pytest.approx(recorded, abs=5 * PERIOD_S)
 
 
 @live
 def test_rejected_program_carries_linuxcnc_message():
     with pytest.raises(lc.LinuxCNCError, match="exceed X's positive limit") as info:
-        lc.run("G21 G90\nG1 X20000 F600\nM2\n", MACHINE)
+        lc.run("G21 G90\nG1 X20000 F600\nM2\n", MACHINE, PLANNER)
     assert info.value.line == 2
     assert isinstance(info.value, ValueError)
 
@@ -255,7 +256,7 @@ def test_timeout_kills_the_instance_and_leaves_nothing(monkeypatch):
 
     monkeypatch.setattr(lc.tempfile, "mkdtemp", mkdtemp)
     with pytest.raises(TimeoutError, match="timeout_s"):
-        lc.record("G21\nG4 P60\nM2\n", MACHINE, timeout_s=4.0)
+        lc.record("G21\nG4 P60\nM2\n", MACHINE, PLANNER, timeout_s=4.0)
     assert len(made) == 1 and Path(made[0]).name.startswith("nctwin-linuxcnc-")
     assert not Path(made[0]).exists()
 

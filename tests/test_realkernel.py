@@ -6,20 +6,21 @@ import dataclasses
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from nctwin import identify
 from nctwin.chapters import linuxcnc as rk
-from nctwin.estimate import best_method, default_method, estimate, learned
-from nctwin.estimate.kernel import fir_settings
+from nctwin.estimate import estimate, learned
+from nctwin.estimate.blend_planner import blend_planner
+from nctwin.estimate.block_overlap import block_overlap
 from nctwin.gcode import parse
-from nctwin.machine import load_machine
-from nctwin.paths import results_dir
+from nctwin.machine import load_profile
 from nctwin.recordings import RecordedProgram
 from nctwin.targets import BlockTargets
 
-MACHINE = load_machine("linuxcnc_sim")  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
+PROFILE = load_profile("linuxcnc_sim")
+MACHINE = PROFILE.machine  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
+PLANNER = PROFILE.control("planner")  # 1 ms, G64 P0.0254 where a program sets none
 
 
 def col(name: str) -> int:
@@ -46,7 +47,7 @@ def test_arc_becomes_chords_on_the_arc():
 
 def test_dwells_and_zero_moves_are_not_moves():
     tp = parse("G21 G90\nG1 X10 F600\nG4 P0.5\nG1 X10\nG1 X20\n", start_mm=(0, 0, 0))
-    data = learned.move_data("p", tp, MACHINE)
+    data = learned.move_data("p", tp, MACHINE, PLANNER)
     assert len(data.moves) == 2
     assert data.dwell_s == 0.5
 
@@ -54,13 +55,13 @@ def test_dwells_and_zero_moves_are_not_moves():
 def test_feed_is_clipped_to_axes_and_control():
     # X at F 30000 mm/min (500 mm/s) -> 200; Z alone at 150 mm/s -> Z's 100; rapid -> 200
     tp = parse("G21 G90\nG1 X10 F30000\nG1 Z10 F9000\nG0 X0\n", start_mm=(0, 0, 0))
-    x = learned.features(learned.model_blocks(tp)[0], MACHINE)
+    x = learned.features(learned.model_blocks(tp)[0], MACHINE, PLANNER)
     np.testing.assert_allclose(x[:, col("feed_mm_s")], [200.0, 100.0, 200.0])
 
 
 def test_path_acceleration_along_the_move():
     tp = parse("G21 G90\nG1 X10 F600\nG1 X20 Y10\nG1 Z10\n", start_mm=(0, 0, 0))
-    acc = learned.features(learned.model_blocks(tp)[0], MACHINE)[:, col("acc_mm_s2")]
+    acc = learned.features(learned.model_blocks(tp)[0], MACHINE, PLANNER)[:, col("acc_mm_s2")]
     np.testing.assert_allclose(acc, [1000.0, 1000.0 * math.sqrt(2), 500.0])
 
 
@@ -77,7 +78,7 @@ def test_path_acceleration_along_the_move():
 )
 def test_linuxcnc_tolerance_rules(g64, tol, naive):
     tp = parse(f"G21 G90\n{g64}\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
-    x = learned.features(learned.model_blocks(tp)[0], MACHINE)
+    x = learned.features(learned.model_blocks(tp)[0], MACHINE, PLANNER)
     np.testing.assert_allclose(x[:, col("tol_mm")], tol)
     np.testing.assert_allclose(x[:, col("naive_tol_mm")], naive)
 
@@ -86,7 +87,7 @@ def test_targets_from_block_targets():
     # two lines of 10 mm at 10 mm/s: measured 1.5 s and 1.25 s over 9.9 and 10 mm
     tp = parse("G21 G90\nG1 X10 F600\nG1 Y10\n", start_mm=(0, 0, 0))
     bt = BlockTargets(np.array([0, 1500, 2750]), np.array([9.9, 10.0]), np.array([1.5, 1.25]))
-    d = learned.move_data("p", tp, MACHINE, bt)
+    d = learned.move_data("p", tp, MACHINE, PLANNER, bt)
     np.testing.assert_allclose(d.targets[:, 0], [9.9 / 1.5, 10 / 1.25])
     np.testing.assert_allclose(d.targets[:, 1], np.log([1.5, 1.25]))  # ln(F t / l)
     np.testing.assert_allclose(d.axis_targets, [[9.9 / 1.5, 0, 0], [0, 8.0, 0]])
@@ -96,40 +97,30 @@ def test_targets_from_block_targets():
 def test_block_overlap_constants_from_acceleration():
     # main cutting feed 100 mm/s (the longer cut) -> A_T = 100 / 1000 = 0.1 s; A_TR = 0.2 s
     tp = parse("G21 G90\nG1 X100 F6000\nG1 Y10 F1200\n", start_mm=(0, 0, 0))
-    m = identify.identified_block_overlap_machine(tp, MACHINE)
+    m = identify.identified_block_overlap(tp, MACHINE, 0.001)
     assert m.cut_time_constant_s == pytest.approx(0.1)
     assert m.rapid_time_constant_s == pytest.approx(0.2)
     assert m.inposition_time_s == (0.0, 0.0, 0.0)
     # a single line: L/F + A_T, LinuxCNC's L/F + F/A
     line = parse("G21 G90\nG1 X100 F6000\n", start_mm=(0, 0, 0))
-    lee = identify.identified_block_overlap_machine(line, MACHINE)
-    assert estimate(line, lee, "block_overlap").cycle_time_s == pytest.approx(1.0 + 0.1)
+    lee = identify.identified_block_overlap(line, MACHINE, 0.001)
+    assert block_overlap(line, MACHINE, lee).cycle_time_s == pytest.approx(1.0 + 0.1)
 
 
 def test_learned_methods_need_recordings():
     tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
-    with pytest.raises(ValueError, match="has no recordings"):
-        estimate(tp, load_machine("paper1_sim"), "bilstm")
-
-
-def test_estimates_read_the_chapters_fit_and_best_method():
-    # linuxcnc_sim's FIR stand-in settings and default method are the chapter's results, read
-    # from its files, not written into the profile
-    results = results_dir() / "linuxcnc_real_kernel"
-    best = pd.read_csv(results / "fir_fit.csv").iloc[0]  # sorted by score
-    settings = fir_settings(MACHINE)
-    for field in identify.FIR_FIELDS:
-        assert getattr(settings, field.removeprefix("fir_")) == pytest.approx(best[field])
-    summary = pd.read_csv(results / "summary.csv")
-    assert default_method(MACHINE) == best_method(summary) == "planner"
-    assert default_method(load_machine("paper1_sim")) == "cam"
+    with pytest.raises(ValueError, match=r"paper1_sim has no \[control.planner\] table"):
+        estimate(tp, load_profile("paper1_sim"), "bilstm")
+    no_recordings = dataclasses.replace(PROFILE, recordings=None)
+    with pytest.raises(ValueError, match="recordings = None of machine profile linuxcnc_sim"):
+        learned.training_data(no_recordings)
 
 
 def _recording(name: str, program: str, time_s: float, source: str = "nctwin") -> RecordedProgram:
     targets = BlockTargets(
         np.array([0, round(time_s / 0.001)]), np.array([60.0]), np.array([time_s])
     )
-    return RecordedProgram(name, program, MACHINE.name, targets, np.zeros(1), 0, "", "", source)
+    return RecordedProgram(name, program, PROFILE.name, targets, np.zeros(1), 0, "", "", source)
 
 
 def test_planner_ablation_on_recordings_by_hand():
@@ -139,7 +130,7 @@ def test_planner_ablation_on_recordings_by_hand():
         "broad_b": _recording("broad_b", "G21 G90 G64\nG1 X60 F3000\n", 1.3 * 1.04),
     }
     programs = {n: (n.split("_")[0], parse(r.program), r.cycle_time_s) for n, r in recs.items()}
-    rows = rk.planner_ablation(programs, MACHINE)
+    rows = rk.planner_ablation(programs, PROFILE)
     rows = rows[rows.rules == "all"]
     assert list(rows.set) == ["train", "broad"]
     assert list(rows["mode"]) == ["G61", "G64"]
@@ -147,11 +138,11 @@ def test_planner_ablation_on_recordings_by_hand():
     np.testing.assert_allclose(rows.err_pct, [0.0, 100 * (1 / 1.04 - 1)])
     summary = rk.method_summary(rows, by=["mode"])
     assert list(summary.underestimates) == [0, 1]
-    gaps = rk.planner_block_gaps(recs["broad_b"], MACHINE, n=1)
+    gaps = rk.planner_block_gaps(recs["broad_b"], PROFILE, n=1)
     assert gaps.block.tolist() == [0] and gaps.kind.tolist() == ["linear"]
     assert gaps.planner_s.iloc[0] == pytest.approx(1.3)
     with pytest.raises(ValueError, match="n = 0"):
-        rk.planner_block_gaps(recs["broad_b"], MACHINE, n=0)
+        rk.planner_block_gaps(recs["broad_b"], PROFILE, n=0)
 
 
 @pytest.mark.parametrize(
@@ -164,20 +155,20 @@ def test_planner_ablation_on_recordings_by_hand():
     ],
 )  # fmt: skip
 def test_path_control_follows_linuxcnc(program, mode):
-    assert rk.path_control(parse("G21 G90\n" + program), MACHINE) == mode
+    assert rk.path_control(parse("G21 G90\n" + program), PROFILE) == mode
 
 
 def test_planner_block_gaps_need_the_program_text():
     rec = _recording("public_x", "", 1.0, source="public/x.ngc")
     with pytest.raises(ValueError, match=r"source = 'public/x\.ngc'"):
-        rk.planner_block_gaps(rec, MACHINE)
+        rk.planner_block_gaps(rec, PROFILE)
 
 
 def test_planner_ablation_by_hand():
     # G61, two lines with a 0.001 rad kink at 60 mm/s: tangent with the kink rule, a stop at
     # full acceleration without it (the sizes of blend arcs do not matter: there are none)
     tp = parse("G21 G90 G61\nG1 X10 F3600\nX20 Y0.01\n", start_mm=(0, 0, 0))
-    rows = rk.planner_ablation({"kink": ("test", tp, 1.0)}, MACHINE)
+    rows = rk.planner_ablation({"kink": ("test", tp, 1.0)}, PROFILE)
     assert list(rows.rules) == list(rk.PLANNER_RULES)
     t = dict(zip(rows.rules, rows.predicted_s, strict=True))
     stop = 2 * (10 / 60 + 60 / 1000)  # two trapezoids from rest to rest (L/F + F/a)
@@ -208,8 +199,8 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
     programs = []
     for text in texts:
         tp = parse(text, start_mm=(0, 0, 0))
-        programs.append((tp, estimate(tp, truth, "planner").cycle_time_s))
-    fit = identify.fit_planner(programs, MACHINE)
+        programs.append((tp, blend_planner(tp, truth, PLANNER).cycle_time_s))
+    fit = identify.fit_planner(programs, MACHINE, PLANNER)
     # the "recordings" stop on whole 1 ms periods, the fit plans half a period per stop: the
     # limits come back within a few tenths of a percent
     np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=5e-3)
@@ -221,8 +212,8 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
 def test_fit_planner_rejects_bad_input():
     tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
     with pytest.raises(ValueError, match="programs is empty"):
-        identify.fit_planner([], MACHINE)
+        identify.fit_planner([], MACHINE, PLANNER)
     with pytest.raises(ValueError, match="allowed > 0"):
-        identify.fit_planner([(tp, 0.0)], MACHINE)
+        identify.fit_planner([(tp, 0.0)], MACHINE, PLANNER)
     with pytest.raises(ValueError, match=r"start = \(500.0, 400.0\) is out of range"):
-        identify.fit_planner([(tp, 1.0)], MACHINE, start=(500.0, 400.0))
+        identify.fit_planner([(tp, 1.0)], MACHINE, PLANNER, start=(500.0, 400.0))

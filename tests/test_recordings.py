@@ -13,12 +13,12 @@ import pytest
 
 from nctwin import record, recordings
 from nctwin.gcode import parse
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.toolpath import MotionKind
 
 SHIPPED = recordings.load_recordings()
-MACHINE = load_machine(recordings.MACHINE)
-PERIOD_S = MACHINE.period_s
+PROFILE = load_profile(recordings.MACHINE)
+PERIOD_S = PROFILE.control("planner").period_s
 OWN = sorted(n for n, r in SHIPPED.items() if r.source == "nctwin")
 PUBLIC = sorted(n for n, r in SHIPPED.items() if r.source != "nctwin")
 #: The two shortest of nctwin's own programs (a few seconds each).
@@ -105,7 +105,7 @@ def test_shipped_recording_is_consistent(name):
 @pytest.mark.parametrize("name", LIVE)
 def test_live_recording_equals_shipped(name):
     shipped = SHIPPED[name]
-    live = record.record_program(name, shipped.program, MACHINE)
+    live = record.record_program(name, shipped.program, PROFILE)
     assert live.n_samples == shipped.n_samples
     assert live.trace_sha256 == shipped.trace_sha256
     np.testing.assert_array_equal(live.targets.junction_sample, shipped.targets.junction_sample)

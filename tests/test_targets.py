@@ -8,7 +8,8 @@ import pytest
 
 from nctwin import parse
 from nctwin.kernel import accdec, fir
-from nctwin.machine import load_machine
+from nctwin.controls import AccDecControl
+from nctwin.machine import load_profile
 from nctwin.motion import Motion
 from nctwin.paths import public_programs_dir
 from nctwin.programs.camstyle import cam_program
@@ -80,24 +81,25 @@ def _contour_head(lines: int) -> str:
 
 
 def _cases():
-    paper1 = load_machine("paper1_sim")
-    generic = load_machine("generic_mill")
-    fir_paper1 = fir.FirSettings.load("paper1_sim")
-    fir_generic = fir.FirSettings.load("generic_mill")
-    yield "pocket", parse(pocket_program(feed_mm_s=50.0, tol_mm=0.3)), paper1, fir_paper1
-    yield "stops_dwells", parse(STOPS_AND_DWELLS), generic, fir_generic
-    yield "contour_head", parse(_contour_head(3000)), generic, fir_generic
+    paper1 = load_profile("paper1_sim")
+    generic = load_profile("generic_mill")
+    yield "pocket", parse(pocket_program(feed_mm_s=50.0, tol_mm=0.3)), paper1
+    yield "stops_dwells", parse(STOPS_AND_DWELLS), generic
+    yield "contour_head", parse(_contour_head(3000)), generic
     for seed in (0, 1, 2):
-        yield f"cam{seed}", parse(cam_program(seed)), generic, fir_generic
+        yield f"cam{seed}", parse(cam_program(seed)), generic
 
 
 CASES = list(_cases())
 
 
-@pytest.mark.parametrize(("name", "tp", "machine", "settings"), CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize(("name", "tp", "profile"), CASES, ids=[c[0] for c in CASES])
 @pytest.mark.parametrize("kernel", ["fir", "accdec"])
-def test_chunked_search_is_bit_identical_to_all_at_once(name, tp, machine, settings, kernel):
-    motion = fir.run(tp, machine, settings) if kernel == "fir" else accdec.run(tp, machine)
+def test_chunked_search_is_bit_identical_to_all_at_once(name, tp, profile, kernel):
+    if kernel == "fir":
+        motion = fir.run(tp, profile.machine, profile.control("fir"))
+    else:
+        motion = accdec.run(tp, profile.machine, profile.accdec or AccDecControl())
     ref = reference_block_targets(motion, tp)
     n_junctions = len(tp) - 1
     # chunks of one junction, chunks that split the junctions unevenly, one chunk exactly, and
@@ -125,8 +127,8 @@ def test_dwell_times_are_read_between_first_and_last_tied_samples():
     # a 10 mm line at 10 mm/s, a 0.5 s dwell, back: on the FIR kernel the dwell's block takes
     # the dwell (to the servo period), and the cycle time is the motion's
     tp = parse("G21 G90 G61\nG1 X10 F600\nG4 P0.5\nX0\n")
-    machine = load_machine("generic_mill")
-    motion = fir.run(tp, machine, fir.FirSettings.load("generic_mill"))
+    generic = load_profile("generic_mill")
+    motion = fir.run(tp, generic.machine, generic.control("fir"))
     t = block_targets(motion, tp)
     assert t.time_s[1] == pytest.approx(0.5, abs=2 * motion.period_s)
     assert t.cycle_time_s == pytest.approx(motion.cycle_time_s, abs=motion.period_s)
@@ -135,7 +137,7 @@ def test_dwell_times_are_read_between_first_and_last_tied_samples():
 
 def test_chunk_size_must_be_positive():
     tp = parse("G21 G90\nG1 X1 F600\nX2\n")
-    machine = load_machine("generic_mill")
-    motion = fir.run(tp, machine, fir.FirSettings.load("generic_mill"))
+    generic = load_profile("generic_mill")
+    motion = fir.run(tp, generic.machine, generic.control("fir"))
     with pytest.raises(ValueError, match="chunk_junctions = 0"):
         block_targets(motion, tp, chunk_junctions=0)

@@ -1,9 +1,10 @@
-"""The ``nctwin`` command line: ``estimate``, ``simulate`` and ``machines``.
+"""The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines`` and ``calibrate``.
 
 ``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the
 machine profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR
 kernel (the profile's ``[control.fir]``) and can write the feed plot and the sampled motion;
-``nctwin machines`` lists the shipped machine profiles. ``-`` reads the program from standard
+``nctwin machines`` lists the shipped machine profiles; ``nctwin calibrate`` fits a profile's
+control to its recordings and writes it into a profile file. ``-`` reads the program from standard
 input. Bad input ends with exit code 2 and one line on standard error, never a traceback:
 ``file:line: reason`` for a line of the program that cannot be read (one such line per error
 the reader lists), ``file: reason`` for a file that is not a program (absent, a directory,
@@ -19,6 +20,7 @@ import math
 import re
 import sys
 from collections.abc import Sequence
+from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +81,11 @@ examples:
   nctwin estimate part.ngc --reader linuxcnc       subroutines, #parameters, G41/G42
   nctwin estimate part.ngc --tool-table tool.tbl   the tools of its T words (LinuxCNC .tbl)
   cat part.nc | nctwin estimate -"""
+
+CALIBRATE_EXAMPLES = """\
+example:
+  nctwin calibrate --recordings linuxcnc --machine linuxcnc_sim \\
+      --output data/machines/linuxcnc_sim.toml      (make calibrate)"""
 
 SIMULATE_EXAMPLES = """\
 The plot has two panels: the feed over time, scaled to the cutting moves (rapids
@@ -196,6 +203,32 @@ def _parser() -> argparse.ArgumentParser:
         help="list the shipped machine profiles",
         description="List the shipped machine profiles (names for --machine).",
         formatter_class=fmt,
+    )
+
+    c = sub.add_parser(
+        "calibrate",
+        help="fit a machine's FIR control to its recordings, into a profile file",
+        description="Fit the FIR kernel's settings to a machine's shipped recordings (a grid\n"
+        "search on recorded cycle times) and write them as the [control.fir] table of a\n"
+        "profile file, with a comment that says which recordings, when, and the residual.",
+        epilog=CALIBRATE_EXAMPLES,
+        formatter_class=fmt,
+    )
+    c.add_argument(
+        "--recordings",
+        required=True,
+        help="name of the shipped recordings the profile names (its recordings key)",
+    )
+    c.add_argument(
+        "--machine",
+        required=True,
+        help="shipped profile name or .toml path of the recorded machine",
+    )
+    c.add_argument(
+        "--output",
+        required=True,
+        metavar="TOML",
+        help="profile file to write (the machine's own file, or a new one: a copy of it)",
     )
     return p
 
@@ -484,6 +517,22 @@ def _gcode_lines(exc: GCodeError) -> list[str]:
     return out
 
 
+def _calibrate(args: argparse.Namespace) -> int:
+    from .identify import calibrate_fir
+
+    profile = load_profile(args.machine)
+    if profile.recordings != args.recordings:
+        raise ValueError(
+            f"recordings = {args.recordings!r} is not the machine's: allowed "
+            f"{profile.recordings!r} (the recordings key of {args.machine})"
+        )
+    control, _, provenance = calibrate_fir(args.machine, args.output, today=date.today())
+    for line in provenance:
+        print(line)
+    print(f"[control.fir] of {args.output}: {control}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     try:
@@ -498,6 +547,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         if args.command == "simulate":
             return _simulate(args, enabled)
+        if args.command == "calibrate":
+            return _calibrate(args)
         return _estimate(args, enabled)
     except GCodeError as exc:
         print("\n".join(_gcode_lines(exc)), file=sys.stderr)

@@ -112,7 +112,8 @@ class AccDecControl:
         Interpolation period :math:`T_I`, in (0, 0.1] s; every time constant is a whole
         number of it.
     cut_time_constant_s : float
-        Acc/dec time constant of cutting feed :math:`A_T` (linear type), in [0, 10] s.
+        Acc/dec time constant of cutting feed :math:`A_T` (linear type), in [0, 10] s, whole
+        periods (as every time constant here).
     rapid_time_constant_s : float
         Acc/dec time constant of rapids :math:`A_{TR}`, in [0, 10] s.
     rapid_bell_s : float
@@ -152,6 +153,8 @@ class AccDecControl:
         ):
             xyz = check_xyz(name, getattr(self, name), 0.0, hi, lo_closed=lo_closed)
             object.__setattr__(self, name, xyz)
+        for name in ("cut_time_constant_s", "rapid_time_constant_s", "rapid_bell_s"):
+            self.periods(name)
 
     def periods(self, name: str) -> int:
         """The time constant ``name`` as a whole number of periods (ValueError if it is not)."""

@@ -386,6 +386,8 @@ def write_control(
         before, after = lines[:first], lines[stop:]
     while before and not before[-1].strip():
         before.pop()
+    while after and not after[0].strip():
+        after.pop(0)
     table = [f"# {line}" for line in (*provenance, f"Written by nctwin on {today.isoformat()}.")]
     table.append(header)
     table += [f"{f.name} = {_toml_value(getattr(control, f.name))}" for f in fields(control)]
