@@ -53,7 +53,7 @@ export ONEDNN_MAX_CPU_ISA := AVX2
 endif
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean linuxcnc record FORCE
+        clean distclean linuxcnc record calibrate FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> linuxcnc -> notebooks (papermill) -> book; prints the HTML path"
@@ -63,6 +63,7 @@ help:
 	@echo "make chromium    install Debian chromium if $(CHROMIUM) is missing"
 	@echo "make linuxcnc    install LinuxCNC (uspace) + libfaketime and the RTAPI_UID user, if missing"
 	@echo "make record      re-record data/recordings/linuxcnc/ on LinuxCNC (needs make linuxcnc)"
+	@echo "make calibrate   fit linuxcnc_sim's [control.fir] to its recordings, into its profile file"
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
@@ -160,6 +161,14 @@ linuxcnc:
 record: venv linuxcnc
 	@t0=$$(date +%s); $(PY) -m nctwin.record; \
 	echo "record: done in $$(( $$(date +%s) - t0 )) s"
+
+# calibrate: what is fitted to the recordings is written into the machine's profile file (with a
+# comment that says which recordings, when, and the residual), never read from results/ at run
+# time. After `make record`, run this and commit the profile.
+calibrate: venv
+	@t0=$$(date +%s); $(VENV)/bin/nctwin calibrate --recordings linuxcnc --machine linuxcnc_sim \
+	  --output data/machines/linuxcnc_sim.toml; \
+	echo "calibrate: done in $$(( $$(date +%s) - t0 )) s"
 
 # ---------------------------------------------------------------------------------------------
 # Steps that talk: each long step prints "[k/N] <step> (last run 9 min 40 s)" before it starts,

@@ -6,16 +6,16 @@ import pytest
 from nctwin import gcode
 from nctwin.chapters import chien2023 as ch
 from nctwin.kernel import fir
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.paths import cache_dir
 from nctwin.programs.training import global_program, mixed_program
 
-MACHINE_B = load_machine("paper1_machine_b")
+MACHINE_B = load_profile("paper1_machine_b")
 
 
 def test_recorded_labels_follow_the_lagging_axes():
     tp = ch.cutting_blocks(gcode.parse("G21 G90 G64 P0.1\nG1 X50 F4200\nY50\n"))
-    motion = fir.run(tp, MACHINE_B, fir.FirSettings.load("paper1_machine_b"))
+    motion = fir.run(tp, MACHINE_B.machine, MACHINE_B.control("fir"))
     rec = ch.Recording(position_gain_1_s=40.0).apply(motion, np.random.default_rng(0))
     switch = np.flatnonzero(np.diff(motion.block))[0]
     # the exactly discretised loop follows a ramp 1 / Kv = 25 ms = 25 samples late, and the
@@ -58,7 +58,7 @@ def test_time_by_length_splits_the_cycle_time():
     from nctwin.learn.models import ModelConfig, build
     from nctwin.learn.train import Scaler, TrainConfig, Trained
 
-    machine = load_machine("paper1_sim")
+    machine = load_profile("paper1_sim")
     run = ch.simulate_one(mixed_program(7, n_lines=200, feed_mm_s=80.0, tol_mm=0.3), machine)
     model = build(ModelConfig("bilstm", n_outputs=2), generator=torch.Generator().manual_seed(0))
     trained = Trained(model, Scaler.fit([run.features], log_columns=[1]),
@@ -79,7 +79,7 @@ def small_ensemble(tmp_path_factory):
 
     from nctwin.learn.models import ModelConfig
 
-    machine = load_machine("paper1_sim")
+    machine = load_profile("paper1_sim")
     texts = [mixed_program(s, n_lines=150, feed_mm_s=80.0, tol_mm=0.3) for s in range(4)]
     runs = [ch.simulate_one(t, machine) for t in texts]
     cfg = ch.train_config(0, scale=8 / ch.MAX_EPOCHS)  # a cap of 8 epochs

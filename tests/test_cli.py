@@ -40,8 +40,8 @@ def test_estimate_json(program, capsys):
     assert data["cycle_time_s"] == pytest.approx(5 / 200 + 3.5)
 
 
-def test_estimate_default_method_is_the_chapters(program, capsys):
-    # linuxcnc_sim defaults to its chapter's best method, the blend-arc planner.
+def test_estimate_default_method_is_the_profiles(program, capsys):
+    # linuxcnc_sim's default_method is its chapter's best method, the blend-arc planner.
     # LinuxCNC by hand: the 5 mm Z rapid is a triangle at Z's 500 mm/s^2, 2 sqrt(5 / 500) =
     # 0.2 s; then 5 mm and 30 mm at 10 mm/s with near-stops at the corners (0.0254 mm
     # tolerance), each plus F / a: 0.5 + 0.02 + 3.0 + 0.01 = 3.53 s; 3.73 s in all (LinuxCNC
@@ -174,10 +174,10 @@ def test_errors_on_standard_input_name_it(monkeypatch, capsys):
 
 def test_machine_file_with_missing_keys_names_them(program, tmp_path, capsys):
     toml = tmp_path / "bad.toml"
-    toml.write_text('description = "half a machine"\nperiod_s = 0.001\nrapid_feed_mm_s = 500.0\n')
+    toml.write_text('[machine]\ndescription = "half a machine"\nrapid_feed_mm_s = 500.0\n')
     assert main(["estimate", str(program), "--machine", str(toml)]) == 2
     line = _one_line_error(capsys)
-    assert line.startswith(f"nctwin: {toml}: missing field(s) ")
+    assert line.startswith(f"nctwin: {toml}: [machine] missing key(s) ")
     assert "axis_max_velocity_mm_s" in line and "max_feed_mm_s" in line
     assert "rapid_feed_mm_s" not in line
 
@@ -194,7 +194,27 @@ def test_machine_file_with_missing_keys_names_them(program, tmp_path, capsys):
         (["estimate"], "nctwin: the following arguments are required: program"),
         (["simulate", "{prog}", "--units", "furlong"], "nctwin: argument --units: invalid"),
         (["simulate", "{prog}", "--plot", "{dir}/no/f.png"], "nctwin: {dir}/no/f.png: No such"),
-        (["estimate", "{prog}", "--method", "bilstm"], "nctwin: machine = 'generic_mill' has no"),
+        (
+            ["estimate", "{prog}", "--method", "bilstm"],
+            "nctwin: recordings = None of machine profile generic_mill names no shipped recordings",
+        ),
+        (
+            ["estimate", "{prog}", "--machine", "paper1_sim", "--method", "planner"],
+            "nctwin: "
+            "method 'planner' needs a control: machine profile paper1_sim has no [control.planner]",
+        ),
+        (
+            [
+                "calibrate",
+                "--recordings",
+                "mtconnect",
+                "--machine",
+                "linuxcnc_sim",
+                "--output",
+                "{dir}/x.toml",
+            ],
+            "nctwin: recordings = 'mtconnect' is not the machine's: allowed 'linuxcnc'",
+        ),
     ],
 )
 def test_ordinary_mistakes_give_one_line_and_exit_2(program, tmp_path, capsys, args, expected):
@@ -251,7 +271,57 @@ def test_progress_bar_on_a_terminal_but_not_with_json(program, capsys, monkeypat
 
 # --- learned estimates never below the physical floor ------------------------------------------
 
+
 #: A 20 mm Z rapid (LinuxCNC sim: rapid 200 mm/s, Z at most 100 mm/s: 0.2 s), then a 100 mm
+# --- a profile is its file's content, not its name ---------------------------------------------
+def _profile_methods():
+    from nctwin.machine import METHOD_CONTROLS, available_machines, load_profile
+
+    for name in available_machines():
+        profile = load_profile(name)
+        for method in METHOD_CONTROLS:
+            learned = method in ("bilstm", "axis_nn")
+            if learned and profile.recordings is None:
+                continue  # refused alike (test_ordinary_mistakes_give_one_line_and_exit_2)
+            yield name, method
+
+
+@pytest.mark.parametrize(("name", "method"), list(_profile_methods()))
+def test_a_copied_profile_estimates_as_the_shipped_one(program, tmp_path, capsys, name, method):
+    from nctwin.machine import profile_path
+
+    copy = tmp_path / "my_mill.toml"
+    copy.write_bytes(profile_path(name).read_bytes())
+    outputs = []
+    for machine in (name, str(copy)):
+        code = main(["estimate", str(program), "--json", "--machine", machine, "--method", method])
+        captured = capsys.readouterr()
+        outputs.append((code, captured.out, captured.err))
+    assert outputs[0] == outputs[1]
+    code, out, err = outputs[0]
+    if code == 0:
+        assert json.loads(out)["method"] == method
+    else:  # a profile without the method's control: one line, the same for the copy
+        assert code == 2 and err.startswith(f"nctwin: method {method!r} needs a control")
+
+
+def test_calibrate_writes_the_shipped_fir_control(tmp_path, capsys):
+    """`nctwin calibrate` on the shipped recordings gives the [control.fir] that
+    linuxcnc_sim.toml holds, with its provenance; nothing else in the file changes."""
+    from nctwin.machine import load_profile, profile_path
+
+    out = tmp_path / "calibrated.toml"
+    args = ["calibrate", "--recordings", "linuxcnc", "--machine", "linuxcnc_sim"]
+    assert main([*args, "--output", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "32 recordings, every 5th of the training sets" in printed
+    calibrated, shipped = load_profile(out), load_profile("linuxcnc_sim")
+    assert calibrated == shipped
+    body = [ln for ln in out.read_text().splitlines() if not ln.startswith("# Written by nctwin")]
+    ship = profile_path("linuxcnc_sim").read_text().splitlines()
+    assert body == [ln for ln in ship if not ln.startswith("# Written by nctwin")]
+
+
 #: square at 20 mm/s (F1200): 5 s a side. Floor: 0.2 + 4 x 5 = 20.2 s. Both networks predict
 #: the sides faster than 20 mm/s (about 18 s for the four).
 SQUARE = "G21 G90 G64 P0.1\nG0 Z-20\nG1 X100 F1200\nY100\nX0\nY0\nM2\n"
@@ -260,11 +330,12 @@ SQUARE = "G21 G90 G64 P0.1\nG0 Z-20\nG1 X100 F1200\nY100\nX0\nY0\nM2\n"
 def test_move_floors_by_hand():
     from nctwin import parse
     from nctwin.estimate.learned import _floored_estimate, move_data, move_floors_s
-    from nctwin.machine import load_machine
+    from nctwin.machine import load_profile
 
-    machine = load_machine("linuxcnc_sim")
+    profile = load_profile("linuxcnc_sim")
+    machine = profile.machine
     tp = parse(SQUARE.replace("M2\n", "G4 P0.5\nM2\n"))
-    data = move_data("square", tp, machine)
+    data = move_data("square", tp, machine, profile.control("planner"))
     assert move_floors_s(data) == pytest.approx([0.2, 5.0, 5.0, 5.0, 5.0])
     # predictions: the rapid and one side above their floors, three sides below
     est = _floored_estimate(tp, data, np.array([0.3, 6.0, 4.0, 1.0, 4.9]), "bilstm", machine)

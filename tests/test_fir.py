@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from nctwin import parse
-from nctwin.kernel import fir
 from nctwin.controls import FirControl
+from nctwin.kernel import fir
 from nctwin.machine import Machine
 from nctwin.targets import block_targets
 

@@ -113,3 +113,18 @@ def test_methods_do_not_import_chapters():
 def test_no_module_does_several_jobs(name):
     n = len(MODULES[name].read_text().splitlines())
     assert n <= MAX_LINES, f"nctwin.{name} has {n} lines (at most {MAX_LINES})"
+
+
+#: The layers that may read reproduced results: the chapters write them, the report renders them.
+READS_RESULTS = ("chapters", "report")
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_only_chapters_and_the_report_read_results(name):
+    """A kernel, an estimator or the command line never looks anything up in results/: what is
+    fitted lives in the machine's profile file."""
+    if name.split(".")[0] in READS_RESULTS or name == "paths":
+        return
+    text = MODULES[name].read_text()
+    for needle in ("results_dir", '"results"', "'results'", "results/"):
+        assert needle not in text, f"nctwin.{name} reads results ({needle!r})"

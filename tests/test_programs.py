@@ -10,7 +10,7 @@ from conftest import SHARED_PROGRAMS
 from nctwin import GCodeError, dump, parse, parse_file
 from nctwin.estimate import estimate
 from nctwin.gcode import interpreter_available
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 
 SUFFIXES = (".ngc", ".nc", ".gcode")
 PROGRAMS = sorted(p.name for p in SHARED_PROGRAMS.glob("*") if p.suffix in SUFFIXES)
@@ -38,7 +38,7 @@ def test_program_parses_or_is_rejected_clearly(shared_programs, name):
     # writing it back and reading it again gives the same tool path (the native reader reads
     # what dump writes: plain moves, whatever the program's own constructs were)
     assert parse(dump(tp), reader="native").allclose(tp)
-    cam = estimate(tp, load_machine(), "cam")
+    cam = estimate(tp, load_profile(), "cam")
     assert np.isfinite(cam.cycle_time_s) and cam.cycle_time_s > 0
 
 

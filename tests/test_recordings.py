@@ -18,6 +18,7 @@ from nctwin.toolpath import MotionKind
 
 SHIPPED = recordings.load_recordings()
 PROFILE = load_profile(recordings.MACHINE)
+MACHINE = PROFILE.machine
 PERIOD_S = PROFILE.control("planner").period_s
 OWN = sorted(n for n, r in SHIPPED.items() if r.source == "nctwin")
 PUBLIC = sorted(n for n, r in SHIPPED.items() if r.source != "nctwin")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from nctwin.chapters import chien2023 as ch
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.programs.training import global_program, mixed_program
 from nctwin.runner import SCHEDULER_ENV, run_tasks
 
@@ -29,7 +29,7 @@ def test_bad_worker_counts_are_named(n_jobs):
 def test_a_dask_cluster_gives_the_local_bits(monkeypatch):
     # the chapter's simulations, as a sweep would send them: two programs on the FIR kernel
     distributed = pytest.importorskip("dask.distributed")
-    machine = load_machine("paper1_sim")
+    machine = load_profile("paper1_sim")
     tasks = [
         (mixed_program(3, n_lines=60, feed_mm_s=80.0, tol_mm=0.3), machine, None, 0),
         (global_program(4, n_lines=60, feed_mm_s=70.0, tol_mm=0.4), machine, None, 1),

@@ -61,9 +61,9 @@ class _Constant:
 @pytest.fixture(scope="module")
 def triangle_run():
     from nctwin.chapters.sun2022 import run_pocket
-    from nctwin.machine import load_machine
+    from nctwin.machine import load_profile
 
-    return run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_machine("sun2022_siemens"))
+    return run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_profile("sun2022_siemens"))
 
 
 def test_eq9_eq10_by_hand(triangle_run):

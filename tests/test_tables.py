@@ -32,7 +32,7 @@ PAPERS = {
     "denkena2020": "Denkena, Bergmann & Stoppel 2020",
     "zhang2023": "Zhang et al. 2023",
 }
-CSV_FILES = sorted(tables.PAPERS_DIR.glob("*.csv"))
+CSV_FILES = sorted(tables.papers_dir().glob("*.csv"))
 
 
 # ---------------------------------------------------------------------------------------------

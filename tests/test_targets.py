@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from nctwin import parse
-from nctwin.kernel import accdec, fir
 from nctwin.controls import AccDecControl
+from nctwin.kernel import accdec, fir
 from nctwin.machine import load_profile
 from nctwin.motion import Motion
 from nctwin.paths import public_programs_dir

@@ -8,7 +8,7 @@ import pytest
 from nctwin import MotionKind, parse
 from nctwin.estimate import estimate
 from nctwin.kernel import fir
-from nctwin.machine import load_machine
+from nctwin.machine import load_profile
 from nctwin.physics.measure import ControllerSamples, controller_samples, nearest_sample
 from nctwin.programs.thinwall import (
     POCKETS,
@@ -24,6 +24,9 @@ from nctwin.report.tables import load_paper_table
 def pockets():
     parsed = {s.number: parse(pocket_program(s), start_mm=start_mm(s)) for s in POCKETS}
     return {k: tp.take(tp.lengths_mm > 0) for k, tp in parsed.items()}
+
+
+GENERIC = load_profile()  # the default profile
 
 
 def _x_rapids(tp):
@@ -68,7 +71,7 @@ def test_cl_spacing_and_cam_times_as_the_papers(pockets):
     summary = load_paper_table("sun2022_summary").set_index("quantity")["value"]
     assert len(pockets[1]) == pytest.approx(summary["pocket1_commanded_points"], rel=0.1)
     paper = load_paper_table("sun2022_table3").set_index("pocket")["cam_s"]
-    machine = load_machine("sun2022_siemens")
+    machine = load_profile("sun2022_siemens")
     for k, tp in pockets.items():
         assert tp.length_mm / len(tp) == pytest.approx(SEGMENT_MM, rel=0.15)
         assert estimate(tp, machine, "cam").cycle_time_s == pytest.approx(paper[k], rel=0.1)
@@ -81,7 +84,7 @@ def test_bad_stepover_is_refused():
 
 def test_controller_samples_rate_and_jitter():
     tp = parse("G1 X200 F6000")
-    motion = fir.run(tp, load_machine(), fir.FirSettings.load())
+    motion = fir.run(tp, GENERIC.machine, GENERIC.control("fir"))
     rec = controller_samples(motion, rate_hz=5.0, jitter_s=0.03, seed=1)
     nominal = np.arange(len(rec.t_s)) / 5.0
     assert len(rec.t_s) == pytest.approx(motion.cycle_time_s * 5, abs=1.5)
@@ -98,7 +101,7 @@ def test_controller_samples_rate_and_jitter():
 def test_nearest_sample_ignores_a_later_pass():
     # out and back along X: the point X10 is passed twice; the pairing keeps to the first pass
     tp = parse("G1 X100 F6000\nX0")
-    motion = fir.run(tp, load_machine(), fir.FirSettings.load())
+    motion = fir.run(tp, GENERIC.machine, GENERIC.control("fir"))
     rec = controller_samples(motion, rate_hz=50.0, jitter_s=0.0)
     first_pass = np.flatnonzero(motion.pos_mm[:, 0] >= 10.0)[0] * motion.period_s
     k = nearest_sample(rec, np.array([[10.0, 0, 0]]), np.array([first_pass]), window_s=0.3)

@@ -220,9 +220,9 @@ def calibrate_fir(
         f"--recordings {loaded.recordings}` (nctwin.identify.calibrate_fir), a grid search of "
         f"{np.prod([len(v) for v in FIR_GRID.values()])} points",
         f"(nctwin.identify.FIR_GRID) on {len(programs)} recordings, every {FIT_EVERY}th of the "
-        f"training sets ({names[0]} ... {names[-1]}).",
-        f"Residual: cycle time off by {row['mean_err_pct']:.2f} % on average, "
-        f"{row['max_err_pct']:.2f} % at worst.",
+        "training sets",
+        f"({names[0]} ... {names[-1]}). Residual: cycle time off by "
+        f"{row['mean_err_pct']:.2f} % on average, {row['max_err_pct']:.2f} % at worst.",
     ]
     out = Path(output)
     if out.resolve() != source.resolve():

@@ -56,7 +56,6 @@ __all__ = [
     "FLOAT_FORMAT",
     "META_COLUMNS",
     "OPS",
-    "PAPERS_DIR",
     "Claim",
     "UnknownTableError",
     "accuracy_pct",
@@ -73,9 +72,6 @@ __all__ = [
     "write_claims",
     "write_table",
 ]
-
-PAPERS_DIR: Path = paths.repo_root() / "data" / "papers"
-"""Default folder of the paper tables; :func:`papers_dir` applies the ``NCTWIN_DATA`` override."""
 
 CITING_COLUMNS: tuple[str, ...] = ("paper", "table", "page_or_section")
 """Columns that cite the source of each row of a paper table."""
@@ -112,7 +108,8 @@ class UnknownTableError(KeyError):
 def papers_dir() -> Path:
     """Return the folder of the paper tables, ``paths.data_dir() / "papers"``.
 
-    ``paths.data_dir()`` is ``<repo>/data``, or ``$NCTWIN_DATA`` if set, read at call time.
+    ``paths.data_dir()`` is the package's shipped data, or ``$NCTWIN_DATA`` if set, read at call
+    time.
     """
     return paths.data_dir() / "papers"
 
