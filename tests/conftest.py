@@ -16,6 +16,18 @@ settings.load_profile("ci")
 SHARED_PROGRAMS = Path(__file__).resolve().parents[2] / "shared" / "programs"
 
 
+#: Fixtures of the tests that run LinuxCNC or its interpreter: their tests are marked ``live``.
+LIVE_FIXTURES = ("linuxcnc_live", "linuxcnc_interpreter")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark every test that runs LinuxCNC ``live`` (``pytest -m "not live"`` leaves them out;
+    ``make test`` runs them all)."""
+    for item in items:
+        if set(getattr(item, "fixturenames", ())) & set(LIVE_FIXTURES):
+            item.add_marker(pytest.mark.live)
+
+
 @pytest.fixture
 def shared_programs() -> Path:
     if not SHARED_PROGRAMS.is_dir():

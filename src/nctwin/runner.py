@@ -75,7 +75,12 @@ def run_tasks(
         backend = "threading" if threads else "loky"
         parallel = Parallel(n_jobs=n_jobs, backend=backend, return_as="generator")
         return _collect(parallel(jobs), len(tasks), desc)
-    from dask.distributed import Client  # only where a cluster is asked for: a slow import
+    try:  # only where a cluster is asked for: a slow import, and an optional extra
+        from dask.distributed import Client
+    except ImportError:
+        raise ValueError(
+            f"{SCHEDULER_ENV} = {address!r} needs Dask: pip install 'nctwin[dask]'"
+        ) from None
 
     with Client(address), parallel_config(backend="dask"):
         return _collect(Parallel(return_as="generator")(jobs), len(tasks), desc)

@@ -51,7 +51,6 @@ __all__ = [
     "fit_masses",
     "fit_restoring",
     "fit_stribeck",
-    "lstm_inputs",
     "mc_dropout",
     "predict",
     "stribeck_n",
@@ -362,11 +361,6 @@ class InputScaling:
 
     def force_inverse(self, f_star: np.ndarray, axis: int) -> np.ndarray:
         return (f_star - 0.5) * 2.0 * self.force_max_n[axis]
-
-
-def lstm_inputs(scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:
-    """Scaled network inputs (R, 14) of one process."""
-    return scaling.inputs(inputs)
 
 
 def predict(nets: dict[str, Trained], scaling: InputScaling, inputs: np.ndarray) -> np.ndarray:

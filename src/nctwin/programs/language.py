@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-__all__ = ["LANGUAGE_PROGRAMS", "language_program"]
+__all__ = ["LANGUAGE_PROGRAMS"]
 
 
 def drill_cycles() -> str:
@@ -286,17 +286,3 @@ LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "offsets_units": offsets_units,
 }
 
-
-def language_program(name: str) -> str:
-    """The text of the language program ``name`` (a key of :data:`LANGUAGE_PROGRAMS`).
-
-    Raises
-    ------
-    ValueError
-        If ``name`` is not one of them.
-    """
-    if name not in LANGUAGE_PROGRAMS:
-        raise ValueError(
-            f"name = {name!r} is not allowed: allowed {', '.join(sorted(LANGUAGE_PROGRAMS))}"
-        )
-    return LANGUAGE_PROGRAMS[name]()
