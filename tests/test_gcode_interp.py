@@ -309,6 +309,17 @@ def test_inch_program(linuxcnc_interpreter):
     assert tp.blend_tol_mm[1] == pytest.approx(0.0254, rel=1e-12)
 
 
+def test_reference_points_are_the_interpreters_parameters(linuxcnc_interpreter):
+    """g28_reference_mm and g30_reference_mm are written to #5161-#5163 and #5181-#5183 (mm,
+    machine coordinates): G28 Z0 in G91 rises from where it is to the G28 point's Z; G30 with no
+    axis word goes to the G30 point; under a G92 offset the points stay where they are."""
+    text = "G0 X1 Y2 Z3\nG91 G28 Z0\nG90 G92 X0\nG30\nM2"
+    tp = parse(text, reader="linuxcnc", g28_reference_mm=(10, 20, 30), g30_reference_mm=(4, 5, 6))
+    np.testing.assert_allclose(tp.end_mm, [[1, 2, 3], [1, 2, 3], [1, 2, 30], [1, 2, 30], [4, 5, 6]])
+    assert tp.line.tolist() == [1, 2, 2, 4, 4]
+    assert (tp.kind == MotionKind.RAPID).all()
+
+
 # ---------------------------------------------------------------------------------------------
 # Bad input: one line, file:line: reason
 # ---------------------------------------------------------------------------------------------

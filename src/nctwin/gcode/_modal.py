@@ -35,6 +35,7 @@ _GROUP_NAMES = (
 )
 _CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
 _G92S = (920, 921, 922, 923)
+_HOMES = (280, 300)  # G28, G30: to reference point 1, 2
 _G_GROUP = {
     **dict.fromkeys((0, 10, 20, 30, 800, *_CYCLES), _MOTION),
     **dict.fromkeys((40, 530, *_G92S), _NONMODAL),
