@@ -33,7 +33,7 @@ def test_the_message_names_file_line_and_construct():
         ("G0 X#<_x>", "#-parameter"),
         ("G42 D2", "G42 cutter compensation"),
         ("G10 L2 P1 X0", "G10 data setting"),
-        ("G28", "G28 reference-point return"),
+        ("G28.1", "G28.1 reference-point setting"),
         ("G93", "G93 inverse-time feed"),
         ("G33 Z-1 K1", "G33 spindle-synchronised motion"),
         ("G76 P1 Z-1", "G76 threading cycle"),

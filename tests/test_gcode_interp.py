@@ -63,8 +63,9 @@ ATOL_MM, FEED_RTOL = 1e-6, 1e-9
 
 def _moving(tp: Toolpath) -> Toolpath:
     """The blocks but zero-length lines and rapids outside canned cycles (see the module
-    docstring: LinuxCNC moves nowhere on a G0/G1 line without axis words)."""
-    still = (tp.kind <= MotionKind.LINEAR) & np.all(tp.start_mm == tp.end_mm, axis=1)
+    docstring: LinuxCNC moves nowhere on a G0/G1 line without axis words). Zero is to 1e-9 mm:
+    LinuxCNC's inch positions of a millimetre point come back with a rounding error."""
+    still = (tp.kind <= MotionKind.LINEAR) & np.all(np.abs(tp.start_mm - tp.end_mm) <= 1e-9, axis=1)
     in_cycle = tp.path_mode == PathMode.EXACT_PATH
     return tp.take(~(still & ~in_cycle))
 
@@ -199,11 +200,11 @@ _coord = st.floats(-50, 50).map(lambda v: round(v, 4))
 @st.composite
 def language_programs(draw) -> str:
     """Random programs in planes, units, distance modes, G92 offsets, path modes, helices and
-    turns, dwells and G81/G83 cycles."""
+    turns, dwells, G81/G83 cycles and G28/G30 returns."""
     lines = [draw(st.sampled_from(["G21", "G20"])), "G90 G17", f"F{draw(st.integers(5, 3000))}"]
     lines.append(f"G0 X{draw(_coord)} Y{draw(_coord)} Z{abs(draw(_coord))}")
     for _ in range(draw(st.integers(1, 12))):
-        op = draw(st.integers(0, 8))
+        op = draw(st.integers(0, 9))
         if op == 0:
             lines.append(f"G{draw(st.sampled_from([0, 1]))} X{draw(_coord)} Z{draw(_coord)}")
         elif op == 1:
@@ -229,8 +230,13 @@ def language_programs(draw) -> str:
             cycle = draw(st.sampled_from(["G81", "G83 Q1.5"]))
             retract = draw(st.sampled_from(["G98", "G99"]))
             lines.append(f"G0 Z5\n{retract} {cycle} X{draw(_coord)} R2 Z-4\nG80")
-        else:
+        elif op == 8:
             lines.append(f"F{draw(st.integers(5, 3000))}")
+        else:
+            mode = draw(st.sampled_from(["G90 G28", "G91 G28", "G90 G30", "G91 G30"]))
+            axes = draw(st.sets(st.sampled_from("XYZ")))
+            lines.append(mode + "".join(f" {a}{draw(_coord)}" for a in sorted(axes)))
+            lines.append("G90")
     return "\n".join(lines) + "\nM2"
 
 
@@ -307,6 +313,17 @@ def test_inch_program(linuxcnc_interpreter):
     assert tp.feed_mm_s == pytest.approx([10 * 25.4 / 60] * 2, rel=1e-12)
     assert tp.path_mode.tolist() == [PathMode.DEFAULT, PathMode.BLEND]
     assert tp.blend_tol_mm[1] == pytest.approx(0.0254, rel=1e-12)
+
+
+def test_reference_points_are_the_interpreters_parameters(linuxcnc_interpreter):
+    """g28_reference_mm and g30_reference_mm are written to #5161-#5163 and #5181-#5183 (mm,
+    machine coordinates): G28 Z0 in G91 rises from where it is to the G28 point's Z; G30 with no
+    axis word goes to the G30 point; under a G92 offset the points stay where they are."""
+    text = "G0 X1 Y2 Z3\nG91 G28 Z0\nG90 G92 X0\nG30\nM2"
+    tp = parse(text, reader="linuxcnc", g28_reference_mm=(10, 20, 30), g30_reference_mm=(4, 5, 6))
+    np.testing.assert_allclose(tp.end_mm, [[1, 2, 3], [1, 2, 3], [1, 2, 30], [1, 2, 30], [4, 5, 6]])
+    assert tp.line.tolist() == [1, 2, 2, 4, 4]
+    assert (tp.kind == MotionKind.RAPID).all()
 
 
 # ---------------------------------------------------------------------------------------------

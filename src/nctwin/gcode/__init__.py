@@ -32,6 +32,18 @@ in ``convert_length_units``).
 * Offsets G92, G92.1 (clears them and zeros parameters 5211-5213), G92.2 (clears them, keeps the
   parameters), G92.3 (restores them from the parameters, which start at zero). Positions are
   machine positions: program coordinates plus the G92 offset.
+* Reference-point returns G28 and G30, as LinuxCNC runs them (``convert_home``) and as a Fanuc
+  control runs the ``G91 G28 Z0.`` of a CAM post before a tool change: a rapid to the
+  intermediate point of the line's axis words, read in the distance mode in force (in G91,
+  ``Z0`` is where Z is), then a rapid of the named axes to the reference point; without axis
+  words, every axis goes to it (after a zero-length rapid, as in LinuxCNC). Both blocks carry
+  the line's number; the motion mode in force is kept (a later line without a G-word moves in
+  it), and an explicit motion code on the line other than G80 is refused. The reference points
+  are LinuxCNC's parameters #5161-#5163 (G28) and #5181-#5183 (G30), here
+  ``g28_reference_mm`` and ``g30_reference_mm``: X, Y, Z in mm, in the Toolpath's (machine)
+  coordinates, which a G92 offset does not move; LinuxCNC's zeros by default. A real machine's
+  home is its own: there, give the home position minus the work offset (and, along Z, minus
+  the tool length). G28.1 and G30.1, which set the points, need LinuxCNC's interpreter.
 * Modal state: G17/G18/G19, G20/G21 (converted to mm), G90/G91, G90.1/G91.1, G94 (which runs
   before the F of its line and clears the feed, as LinuxCNC's does), G98/G99, F.
   A G80 beside another motion code of its line gives way to it, as in LinuxCNC (``read_g``).

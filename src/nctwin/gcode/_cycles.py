@@ -1,6 +1,7 @@
 """G92 offsets and canned cycles (G73, G74, G81-G89): the constructs that carry state from line
 to line in ways a cumulative sum cannot, interpreted one by one on the lines that hold them, as
-LinuxCNC 2.9 does (``convert_axis_offsets`` in interp_convert.cc, interp_cycles.cc)."""
+LinuxCNC 2.9 does (``convert_axis_offsets`` in interp_convert.cc, interp_cycles.cc); and the
+G28/G30 reference points under G92 offsets (``convert_home``)."""
 
 from __future__ import annotations
 
@@ -67,7 +68,9 @@ class _Sticky:
     ijk: tuple[float, float, float] = (np.nan, np.nan, np.nan)
 
 
-def _special_positions(L: _Lines, axis_given, axis_val, cycle_line, moves, start, errors, cycles):
+def _special_positions(
+    L: _Lines, axis_given, axis_val, hl, home_mm, cycle_line, moves, start, errors, cycles
+):
     """Machine positions of a program with G92 offsets or canned cycles, and the offsets.
 
     Positions are followed in program coordinates (in mm), as LinuxCNC follows them, and the
@@ -77,23 +80,33 @@ def _special_positions(L: _Lines, axis_given, axis_val, cycle_line, moves, start
     are filled in as the loop goes. A cycle works in program units, as LinuxCNC's: it starts
     from the number the program gave where there is one (a word, or the end of a cycle, in the
     same units and with no incremental step since).
+
+    ``home_mm`` (len(hl), 3) holds the machine coordinate each G28/G30 line of ``hl`` sends an
+    axis to (NaN for the others): in program coordinates, that coordinate minus the G92 offset
+    in force, as LinuxCNC's ``find_relative`` makes it. ``moves`` marks the lines that move in
+    their motion mode (not the G28/G30 lines, which leave the cycles' initial level as it is).
     """
     n = len(L.scale)
     nonmodal = L.G[_NONMODAL]
     g53 = nonmodal == 530  # machine coordinates: program coordinates minus the G92 offset
     g92 = np.stack([L.has[x] for x in "XYZ"], axis=1) & (nonmodal == 920)[:, None]
+    target = np.full((n, 3), np.nan)  # the machine coordinates of G28/G30 (NaN elsewhere)
+    target[hl] = home_mm
+    home = ~np.isnan(target)
     anchor = (
         (axis_given & ~L.incremental[:, None])
         | (cycle_line | _IS_G92[nonmodal] & (nonmodal != 920))[:, None]  # every axis moves
         | g92
+        | home
     )
     step = np.where(axis_given & L.incremental[:, None] & ~cycle_line[:, None], axis_val, 0.0)
     csum = np.cumsum(step, axis=0)
     last = np.where(anchor, np.arange(n)[:, None], -1)
     np.maximum.accumulate(last, axis=0, out=last)
-    aval = axis_val.copy()  # the program coordinate of each anchor
+    aval = np.where(home, target, axis_val)  # the program coordinate of each anchor
     uval = np.stack([L.W[x] for x in "XYZ"], axis=1)  # ... in its line's units, where exact
     uval[g53] = np.nan
+    uval[home] = np.nan
     n_steps = np.cumsum(step != 0.0, axis=0)
     off = np.zeros((n, 3))  # the G92 offsets in force at each line
 
@@ -138,6 +151,7 @@ def _special_positions(L: _Lines, axis_given, axis_val, cycle_line, moves, start
                 saved = saved if nonmodal[k] == 922 else np.zeros(3)
             off[k:] = o
             aval[k:][g53[k:]] = axis_val[k:][g53[k:]] - o
+            aval[k:][home[k:]] = (target[k:] - o)[home[k:]]
             aval[k] = cur
             if nonmodal[k] != 920:
                 uval[k] = np.nan
@@ -165,7 +179,7 @@ def _special_positions(L: _Lines, axis_given, axis_val, cycle_line, moves, start
     for a in range(3):
         prog = _anchored(anchor[:, a], aval[:, a], step[:, a], start[a])
         # a line without motion leaves the tool where it is, whatever its offsets
-        pos[:, a] = _ffill(moves, prog + off[:, a], start[a])
+        pos[:, a] = _ffill(moves | home.any(1), prog + off[:, a], start[a])
     return pos, off
 
 

@@ -1,5 +1,6 @@
 """The reader's errors: :class:`GCodeError`, and :class:`_Errors`, which collects every error
-of a program and raises them at once, in line order, up to :data:`MAX_ERRORS`."""
+of a program and raises them at once, in line order, up to :data:`MAX_ERRORS`; and the check of
+the readers' point arguments."""
 
 from __future__ import annotations
 
@@ -107,3 +108,20 @@ class _Errors:
             errors.append(GCodeError(i + 1, text, reason, self.source))
         e = errors[0]
         raise GCodeError(e.line, e.text, e.reason, self.source, errors, len(first) - len(errors))
+
+
+def _point_mm(name: str, value) -> np.ndarray:
+    """A keyword argument that is a point (3 finite numbers, mm) as an array.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument and its value, if it is not 3 finite numbers.
+    """
+    try:
+        point = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        point = np.zeros(0)
+    if point.shape != (3,) or not np.isfinite(point).all():
+        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
+    return point

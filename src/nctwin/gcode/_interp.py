@@ -27,9 +27,11 @@ units, planes, offsets. Its canonical moves are turned into the same
   Feeds (``set_feed_rate``, inches per minute) become mm/s.
 * Offsets are added as LinuxCNC's canon adds them (``rotate_and_offset_pos`` in emccanon.cc):
   the G92 offset, the XY rotation (G10 L2 R), the G5x offset, the tool length offset. Work offsets
-  come from an empty parameter file (all zero), tool lengths and diameters from the tool table:
-  by default the one of nctwin's LinuxCNC configuration (:data:`LINUXCNC_TOOL_TABLE`, tool 1 of
-  diameter 0 and length 0), so that compensated paths are the ones the live LinuxCNC runs.
+  come from a parameter file that holds only the G28 and G30 reference points
+  (``g28_reference_mm``, ``g30_reference_mm``; zero by default), so they are zero; tool lengths
+  and diameters come from the tool table: by default the one of nctwin's LinuxCNC configuration
+  (:data:`LINUXCNC_TOOL_TABLE`, tool 1 of diameter 0 and length 0), so that compensated paths
+  are the ones the live LinuxCNC runs.
 * Arcs: ``arc_feed`` gives the end and centre in the plane's axis order and the signed turns;
   an arc of T turns becomes T-1 full turns then the arc, each with its share of the helix, as
   the native reader makes it.
@@ -87,8 +89,8 @@ from pathlib import Path
 import numpy as np
 
 from ..toolpath import PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
-from ._errors import GCodeError
-from ._modal import MM_PER_INCH
+from ._errors import GCodeError, _point_mm
+from ._modal import _HOMES, MM_PER_INCH
 
 #: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -193,6 +195,8 @@ def read_linuxcnc(
     units: str = "mm",
     block_delete: bool = False,
     tool_table: str | PathLike | None = None,
+    g28_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    g30_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     max_moves: int = MAX_MOVES,
     timeout_s: float | None = None,
 ) -> Toolpath:
@@ -214,6 +218,9 @@ def read_linuxcnc(
     tool_table : path, optional
         A LinuxCNC tool table (``.tbl``) for tool lengths (G43) and diameters (G41/G42 D);
         default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC configuration.
+    g28_reference_mm, g30_reference_mm : tuple of 3 floats
+        The G28 and G30 reference points in machine coordinates (mm), written to the
+        interpreter's parameters #5161-#5163 and #5181-#5183; default zero, as LinuxCNC's.
     max_moves : int
         The reader stops with an error after this many canonical moves.
     timeout_s : float, optional
@@ -234,6 +241,13 @@ def read_linuxcnc(
     """
     if units not in ("mm", "inch"):
         raise ValueError(f"units must be 'mm' or 'inch', got {units!r}")
+    references = {
+        first: _point_mm(name, point).tolist()
+        for first, name, point in (
+            (5161, "g28_reference_mm", g28_reference_mm),
+            (5181, "g30_reference_mm", g30_reference_mm),
+        )
+    }
     if not isinstance(max_moves, int) or max_moves < 1:
         raise ValueError(f"max_moves must be an int >= 1, got {max_moves!r}")
     if timeout_s is None:
@@ -267,6 +281,9 @@ def read_linuxcnc(
             "unitcode": "G20" if units == "inch" else "G21",
             "initcode": f"G64 P{PATH_SENTINEL:.0f} Q{PATH_SENTINEL:.0f}",
             "block_delete": bool(block_delete),
+            "parameters": [
+                [first + a, v] for first, point in references.items() for a, v in enumerate(point)
+            ],
             "max_moves": max_moves,
             "deadline_s": max(timeout_s - _CHILD_MARGIN_S, 0.5 * timeout_s),
             "home": tmp,
@@ -324,13 +341,14 @@ def _run_child(job: dict, folder, timeout_s: float, source: str | None) -> bytes
 
 
 def _tables(raw: bytes):
-    """The child's header and its tables: moves (M, 7), events (E, 8: the moves before each, then
-    line, path mode, P, Q, units, feed mode, motion mode) and modal records (K, 13)."""
+    """The child's header and its tables: moves (M, 7), events (E, 9: the moves before each, then
+    line, path mode, P, Q, units, feed mode, motion mode, the line's non-modal code) and modal
+    records (K, 13)."""
     cut = raw.index(b"\n")
     header = json.loads(raw[:cut])
     sizes = header["bytes"]
     if not sizes:
-        return header, np.zeros((0, _N_MOVE)), np.zeros((0, 8)), np.zeros((0, _N_MODAL))
+        return header, np.zeros((0, _N_MOVE)), np.zeros((0, 9)), np.zeros((0, _N_MODAL))
     bounds = np.cumsum([cut + 1, *sizes])
     view = memoryview(raw)  # no copies: the arrays are views of the child's bytes
     part = [view[a:b] for a, b in itertools.pairwise(bounds)]
@@ -349,10 +367,11 @@ def _tables(raw: bytes):
                 g[:, 5],  # units
                 g[:, 7],  # feed mode
                 g[:, 1],  # motion mode
+                g[:, 2],  # the line's code of the non-modal group (G4, G28, G92, ...), or -1
             ]
         )
         if len(st)
-        else np.zeros((0, 8))
+        else np.zeros((0, 9))
     )
     modal = np.frombuffer(part[3], np.float64).reshape(-1, _N_MODAL)
     return header, moves, events, modal
@@ -413,7 +432,7 @@ def _reason(message: str, name: str, program: Path, folder) -> str:
 # ---------------------------------------------------------------------------------------------
 def _after_states(events: np.ndarray) -> np.ndarray:
     """The state each event's moves run in: the one the next event reports (see the module
-    docstring), the last event's own for the last one. Shape (E, 7)."""
+    docstring), the last event's own for the last one. Shape (E, 8)."""
     if not len(events):
         return events
     return np.vstack([events[1:], events[-1:]])
@@ -566,9 +585,10 @@ def _cycle_exact(kind, ev, after, start, end, plane) -> np.ndarray:
     That rapid keeps the tool's place in the plane, and the move after it is the rapid over the
     hole at R's height. Without it, a first move that keeps the place in the plane (the hole
     straight below) is followed by a rapid down to R or by a feed; the one exception, a G87 back
-    boring cycle under the tool with the tool exactly at R, is taken as the rapid to R.
+    boring cycle under the tool with the tool exactly at R, is taken as the rapid to R. A G28
+    or G30 line in a cycle's motion mode makes no cycle: its rapids keep the path mode in force.
     """
-    cycle = np.isin(after[ev, 6], _CYCLES)
+    cycle = np.isin(after[ev, 6], _CYCLES) & ~np.isin(after[ev, 7], _HOMES)
     if not cycle.any():
         return cycle
     first = np.r_[True, ev[1:] != ev[:-1]]

@@ -12,6 +12,9 @@ for) runs it as a script, with one argument, a JSON object:
     What the interpreter runs before the program (``G21``/``G20``; the path-mode sentinel).
 ``block_delete``
     The block-delete switch.
+``parameters``
+    ``[number, value]`` pairs, the interpreter's parameter file (the G28 and G30 reference
+    points, #5161-#5163 and #5181-#5183, in mm, the machine's units); the others are zero.
 ``max_moves``, ``deadline_s``
     Limits: canonical moves, and seconds of wall-clock time (checked when LinuxCNC asks).
 ``home``, ``out``
@@ -236,7 +239,8 @@ def main():
         import gcode
 
         canon = Canon(job, _Tools(job["tool_table"]))
-        open(canon.parameter_file, "w").close()
+        with open(canon.parameter_file, "w") as f:  # in increasing order, as LinuxCNC reads it
+            f.writelines(f"{int(k)} {float(v)!r}\n" for k, v in sorted(job["parameters"]))
         result, line = gcode.parse(job["program"], canon, job["unitcode"], job["initcode"])
         if result > gcode.MIN_ERROR:
             header["error"] = [line, gcode.strerror(result)]

@@ -35,9 +35,10 @@ _GROUP_NAMES = (
 )
 _CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
 _G92S = (920, 921, 922, 923)
+_HOMES = (280, 300)  # G28, G30: to reference point 1, 2
 _G_GROUP = {
     **dict.fromkeys((0, 10, 20, 30, 800, *_CYCLES), _MOTION),
-    **dict.fromkeys((40, 530, *_G92S), _NONMODAL),
+    **dict.fromkeys((40, 530, *_G92S, *_HOMES), _NONMODAL),
     **dict.fromkeys((170, 180, 190), _PLANE),
     **dict.fromkeys((200, 210), _UNITS),
     **dict.fromkeys((900, 910), _DIST),
@@ -58,7 +59,7 @@ def _code_set(*codes: int) -> np.ndarray:
     return table
 
 
-_IS_CYCLE, _IS_G92 = _code_set(*_CYCLES), _code_set(*_G92S)
+_IS_CYCLE, _IS_G92, _IS_HOME = _code_set(*_CYCLES), _code_set(*_G92S), _code_set(*_HOMES)
 _IS_ARC, _PECKS = _code_set(20, 30), _code_set(730, 830)
 _DWELLS = _code_set(740, 820, 840, 860, 880, 890)  # cycles with a P dwell
 _G_CODES = np.array(sorted(_G_GROUP), dtype=np.int64)
@@ -66,7 +67,7 @@ _G_GROUPS = np.array([_G_GROUP[c] for c in _G_CODES], dtype=np.int64)
 #: Codes LinuxCNC reads and this reader does not: what they are.
 _G_LINUXCNC = {
     **dict.fromkeys((410, 411, 420, 421), "cutter compensation"),
-    **dict.fromkeys((280, 281, 300, 301), "reference-point return"),
+    **dict.fromkeys((281, 301), "reference-point setting"),
     100: "data setting",
     930: "inverse-time feed",
     950: "feed per revolution",

@@ -19,7 +19,7 @@ from ..toolpath import (
     arc_sweep,
 )
 from ._cycles import _Lines, _special_positions
-from ._errors import _NEEDS_LINUXCNC, GCodeError, _Errors
+from ._errors import _NEEDS_LINUXCNC, GCodeError, _Errors, _point_mm
 from ._lexer import _L, _LETTERS, _clean, _lex
 from ._modal import (
     _ARCDIST,
@@ -34,6 +34,7 @@ from ._modal import (
     _IS_ARC,
     _IS_CYCLE,
     _IS_G92,
+    _IS_HOME,
     _KIND_OF_MOTION,
     _MOTION,
     _NONMODAL,
@@ -63,6 +64,8 @@ def parse(
     dwell_p_unit: str = "s",
     block_delete: bool = False,
     start_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    g28_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    g30_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     arc_tol_mm: float = 0.005,
     arc_tol_rel: float = 0.001,
 ) -> Toolpath:
@@ -83,6 +86,13 @@ def parse(
         Whether the block-delete switch is on (lines starting with ``/`` are skipped).
     start_mm : tuple of 3 floats
         Tool position before the first block.
+    g28_reference_mm, g30_reference_mm : tuple of 3 floats
+        The reference points G28 and G30 send the tool to (LinuxCNC's parameters #5161-#5163
+        and #5181-#5183, in mm): X, Y, Z in the Toolpath's coordinates, the machine
+        coordinates of a machine whose work offsets (G54-G59) and tool lengths are zero, as
+        this reader reads a program; a G92 offset does not move them. Default: LinuxCNC's
+        zeros. On a real machine, where G28 goes to its home position, this is that position
+        minus the work offset (and minus the tool length along Z).
     arc_tol_mm, arc_tol_rel : float
         An arc whose start and end radii differ by more than
         ``max(arc_tol_mm, arc_tol_rel * radius)`` is rejected.
@@ -106,9 +116,13 @@ def parse(
     for name, v in (("arc_tol_mm", arc_tol_mm), ("arc_tol_rel", arc_tol_rel)):
         if not (np.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
-    start = np.asarray(start_mm, dtype=float)
-    if start.shape != (3,) or not np.isfinite(start).all():
-        raise ValueError(f"start_mm must be 3 finite numbers, got {start_mm!r}")
+    start = _point_mm("start_mm", start_mm)
+    references = np.stack(
+        [
+            _point_mm("g28_reference_mm", g28_reference_mm),
+            _point_mm("g30_reference_mm", g30_reference_mm),
+        ]
+    )
 
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     raw_lines = text.split("\n")
@@ -128,14 +142,18 @@ def parse(
         inch=units == "inch",
         p_scale=1e-3 if dwell_p_unit == "ms" else 1.0,
         start=start,
+        references=references,
         arc_tol=(arc_tol_mm, arc_tol_rel),
     )
     errors.raise_all(n_lines)
     return tp
 
 
-def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> Toolpath:
-    """Modal interpretation of the words of lines ``0..n-1``; returns the Toolpath."""
+def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, arc_tol) -> Toolpath:
+    """Modal interpretation of the words of lines ``0..n-1``; returns the Toolpath.
+
+    ``references`` (2, 3) holds the reference points of G28 and G30 (mm).
+    """
     code, value, line = words["code"], words["value"], words["line"]
     # ---- one value per line and letter; a letter twice in a line is an error (not G, M)
     row = _ROW[code]
@@ -223,11 +241,22 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
         "G4 with X as its time cannot share a line with motion: give the dwell time with P",
     )
 
-    # ---- what each line does: its motion (the modal one, if it has axis words), or G92
+    # ---- what each line does: its motion (the modal one, if it has axis words), G92, or a
+    # G28/G30 return, which leaves the motion mode as it is
     axis_given = np.stack([has["X"] & ~fanuc_dwell, has["Y"], has["Z"]], axis=1)
+    # the G28/G30 lines (few, hl): their axis words give the intermediate point, then the axes
+    # they name (all, if none) go to the reference point, home_mm (NaN for the axes that stay)
+    home_line = _IS_HOME[G[_NONMODAL]]
+    hl = np.flatnonzero(home_line)
+    named = axis_given[hl]
+    home_mm = np.where(
+        named | ~named.any(1)[:, None], references[(G[_NONMODAL, hl] == 300).astype(int)], np.nan
+    )
     axis_given[g92_line] = False  # G92 takes the axis words as the current position
+    axis_given[hl] = False
     any_axis = axis_given.any(1)
     arc_line = _IS_ARC[motion] & (any_axis | ijk)
+    arc_line[hl] = False
     cycle_line = _IS_CYCLE[motion] & any_axis
     moves = any_axis | arc_line
     errors.at_lines(
@@ -238,9 +267,10 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
         g92_line & ~(has["X"] | has["Y"] | has["Z"]), "G92 without an axis word (X, Y or Z)"
     )
     errors.at_lines(
-        g92_line & (G[_MOTION] >= 0) & (G[_MOTION] != 800),
+        (g92_line | home_line) & (G[_MOTION] >= 0) & (G[_MOTION] != 800),
         lambda i: (
-            f"G92 and {_fmt_g(int(G[_MOTION, i]))} cannot share a line: both use the axis words"
+            f"{_fmt_g(int(G[_NONMODAL, i]))} and {_fmt_g(int(G[_MOTION, i]))} cannot share a"
+            " line: both use the axis words"
         ),
     )
     explicit_cycle = _IS_CYCLE[G[_MOTION]]
@@ -289,7 +319,8 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
         )
         turns = np.clip(p_turns, 1, MAX_BLOCKS_PER_LINE).astype(np.int64)
 
-    # ---- positions (machine coordinates: program coordinates plus the G92 offsets)
+    # ---- positions (machine coordinates: program coordinates plus the G92 offsets); a G28/G30
+    # line ends with its axes at the reference point, whatever the offsets
     axis_val = np.stack([W["X"], W["Y"], W["Z"]], axis=1) * scale[:, None]
     special = cycle_line | _IS_G92[G[_NONMODAL]]
     cycles: dict[int, list] = {}
@@ -300,15 +331,21 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
             _spindle(code, value, line, n), p_scale,
         )  # fmt: skip
         pos, off = _special_positions(
-            L, axis_given, axis_val, cycle_line, moves, start, errors, cycles
+            L, axis_given, axis_val, hl, home_mm, cycle_line, moves, start, errors, cycles
         )
     else:
         off = np.zeros((n, 3))
         pos = np.empty((n, 3))
         for a in range(3):
             step = np.where(axis_given[:, a] & incremental, axis_val[:, a], 0.0)
-            pos[:, a] = _anchored(axis_given[:, a] & ~incremental, axis_val[:, a], step, start[a])
+            anchor = axis_given[:, a] & ~incremental
+            value_mm = axis_val[:, a].copy()
+            anchor[hl], value_mm[hl] = ~np.isnan(home_mm[:, a]), home_mm[:, a]
+            pos[:, a] = _anchored(anchor, value_mm, step, start[a])
     prev = np.vstack([start, pos[:-1]]) if n else pos
+    # the intermediate point of each G28/G30 line: its axis words in the distance mode in force
+    to = np.where(incremental[hl, None], prev[hl] + axis_val[hl], axis_val[hl] + off[hl])
+    via = np.where(named, to, prev[hl])
 
     # ---- arcs
     center = np.full((n, 3), np.nan)
@@ -322,11 +359,14 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, arc_tol) -> T
     kind = np.full(n, MotionKind.DWELL, dtype=np.int8)
     for c, k in _KIND_OF_MOTION.items():
         kind[motion == c] = k
+    kind[home_line] = MotionKind.RAPID
+    moves |= home_line
     simple = moves & ~cycle_line
-    if cycles or (turns > 1).any() or (dwell_line & moves).any():
+    if cycles or (turns > 1).any() or (dwell_line & moves).any() or len(hl):
         blocks = _blocks(
-            start, prev, pos, center, plane, kind, simple, turns, dwell_line, dwell_t, cycles
-        )
+            start, prev, pos, center, plane, kind, simple, turns, hl, via, dwell_line, dwell_t,
+            cycles,
+        )  # fmt: skip
     else:
         bl = np.flatnonzero(moves | dwell_line)
         blocks = {
@@ -452,16 +492,24 @@ def _arc_centers(ai, prev, pos, plane, motion, W, has, scale, arc_absolute, off,
     return c
 
 
-def _blocks(start, prev, pos, center, plane, kind, simple, turns, dwell_line, dwell_t, cycles):
+def _blocks(
+    start, prev, pos, center, plane, kind, simple, turns, hl, via, dwell_line, dwell_t, cycles
+):
     """The blocks of each line, in order: its dwell, then its motion (one block per turn of an
-    arc, or the moves of its canned cycle). Each block starts where the previous one ended."""
+    arc, the two rapids of a G28/G30 line of ``hl``, the first to its intermediate point
+    ``via``, or the moves of its canned cycle). Each block starts where the previous one
+    ended."""
     # lines and arcs: an arc of T turns is T-1 full turns then the arc, each with its share of
     # the helix's travel along the plane's normal
     ml = np.flatnonzero(simple)
     t = turns[ml]
+    homes = np.searchsorted(ml, hl)
+    t[homes] += 1
+    first = np.cumsum(t) - t
     mline = np.repeat(ml, t)
-    sub = np.arange(len(mline)) - np.repeat(np.cumsum(t) - t, t)
+    sub = np.arange(len(mline)) - np.repeat(first, t)
     mend, mcen = pos[mline], center[mline]
+    mend[first[homes]] = via
     multi = turns[mline] > 1
     if multi.any():
         i, j = mline[multi], sub[multi]

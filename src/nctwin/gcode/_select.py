@@ -70,11 +70,14 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
         error of the program, unless it names a construct only the interpreter reads: then the
         interpreter's, which read it.
     **kwargs
-        ``source``, ``units``, ``block_delete`` for both readers; ``dwell_p_unit``,
-        ``start_mm``, ``arc_tol_mm``, ``arc_tol_rel`` for the native reader only (with
-        ``reader="linuxcnc"`` only their defaults are allowed; with ``"auto"`` a non-default one
-        keeps the program on the native reader); ``tool_table``, ``max_moves``, ``timeout_s``,
-        ``folder`` for the interpreter only.
+        ``source``, ``units``, ``block_delete``, ``g28_reference_mm`` and ``g30_reference_mm``
+        (the points G28 and G30 return to, LinuxCNC's parameters #5161-#5163 and #5181-#5183:
+        X, Y, Z in mm in the Toolpath's coordinates, which a G92 offset does not move; default
+        zero, as in LinuxCNC) for both readers; ``dwell_p_unit``, ``start_mm``, ``arc_tol_mm``,
+        ``arc_tol_rel`` for the native reader only (with ``reader="linuxcnc"`` only their
+        defaults are allowed; with ``"auto"`` a non-default one keeps the program on the native
+        reader); ``tool_table``, ``max_moves``, ``timeout_s``, ``folder`` for the interpreter
+        only.
 
     Returns
     -------
