@@ -291,6 +291,22 @@ def test_pause_is_the_run_time_counter_stopping_while_active(tmp_path):
     assert stalled(mtc.PAUSE_S - 1).valid
 
 
+def test_a_minute_glitch_of_the_counter_neither_makes_nor_hides_a_pause(tmp_path):
+    def counter(stop_s: float):
+        """The counter reads 51-59 s at 1-9 s, stops ``stop_s``, then turns the minute with the
+        control's glitch (a sample of 0 s, then 60 s) and goes on."""
+        events = [e for e in _run_events() if e[1] != "Program_Runtime_Seconds"]
+        ticks = [(s, 50 + s) for s in range(1, 10)] + [(9.98 + stop_s, 0)]
+        ticks += [(10 + stop_s + s, 60 + s) for s in range(2)]
+        return _verdict(
+            tmp_path, events + [(t, "Program_Runtime_Seconds", str(v)) for t, v in ticks]
+        )
+
+    assert counter(0.0).valid
+    v = counter(6.0)
+    assert v.reasons == ("pause",) and v.detail == "the run-time counter stops for 6 s while ACTIVE"
+
+
 def test_feed_override_logged_measured_or_unknown(tmp_path):
     v = _verdict(tmp_path, [*_run_events(), (8.0, "Feed_Override", "90.000000")])
     assert v.reasons == ("feed_override",) and v.detail == "Feed_Override 90 % while feeding"
