@@ -1,6 +1,6 @@
 """A non-editable install carries the shipped data: ``pip install --target`` copies the package
-with ``nctwin/data`` (machine profiles, paper tables, programs, recordings; no ``cache``), and
-the copy, run from another folder, imports from there and estimates a program."""
+with ``nctwin/data`` (machine profiles, NIST's logs, paper tables, programs, recordings; no
+``cache``), and the copy, run from another folder, imports from there and estimates a program."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-SHIPPED = ("machines", "papers", "programs", "recordings")
+SHIPPED = ("machines", "nist", "papers", "programs", "recordings")
 PROGRAM = "G21 G90\nG0 X0 Y0\nG1 X10 Y0 F600\nG1 X10 Y10\nM2\n"
 
 

@@ -20,7 +20,7 @@ LAYERS = (
     ("physics",),
     ("kernel",),
     ("programs",),
-    ("recordings",),
+    ("recordings", "mtconnect"),
     ("learn",),
     ("methods",),
     ("estimate",),

@@ -1,8 +1,9 @@
 """Where the package finds its shipped data, keeps its caches and writes its results.
 
-Shipped inputs (paper tables, machine profiles, programs, recordings) travel with the package:
-they are the folder ``data`` inside it, found through :func:`importlib.resources.files`, so a
-wheel or a ``pip install --target`` copy finds them as a clone does. In a clone,
+Shipped inputs (paper tables, machine profiles, programs, recordings, NIST's logs) travel with
+the package: they are the folder ``data`` inside it, found through
+:func:`importlib.resources.files`, so a wheel or a ``pip install --target`` copy finds them as a
+clone does. In a clone,
 ``src/nctwin/data`` is a link to the repository's ``data/`` folder, where the files live.
 
 Every folder can be moved by an environment variable, read at call time:
@@ -32,6 +33,7 @@ from pathlib import Path
 __all__ = [
     "cache_dir",
     "data_dir",
+    "nist_dir",
     "public_programs_dir",
     "repo_root",
     "results_dir",
@@ -99,8 +101,8 @@ def data_dir() -> Path:
     -------
     Path
         ``$NCTWIN_DATA`` if set, else the package's ``data`` folder (in a checkout it resolves
-        to ``<repo>/data``). Holds ``machines/*.toml``, ``papers/``, ``programs/`` and
-        ``recordings/``.
+        to ``<repo>/data``). Holds ``machines/*.toml``, ``nist/``, ``papers/``, ``programs/``
+        and ``recordings/``.
     """
     env = os.environ.get("NCTWIN_DATA")
     return Path(env) if env else _package_data()
@@ -163,3 +165,10 @@ def public_programs_dir() -> Path:
     ``data/programs/public/`` byte for byte under their own licence (GPL, not the MIT code's);
     its README gives each file's origin, licence and SHA-256."""
     return data_dir() / "programs" / "public"
+
+
+def nist_dir() -> Path:
+    """NIST's SMS Test Bed data (public, NIST's notice): ``nc/`` (the 23 programs), ``logs/`` (80
+    MTConnect logs of two Hurco VMX 24) and ``Devices.xml``, shipped in ``data/nist/`` byte for
+    byte; its README gives the source, the notice and every file's SHA-256."""
+    return data_dir() / "nist"
