@@ -285,4 +285,3 @@ LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "parametric_curve": parametric_curve,
     "offsets_units": offsets_units,
 }
-
