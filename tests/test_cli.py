@@ -52,6 +52,7 @@ def test_estimate_default_method_is_the_profiles(program, capsys):
     assert data["cycle_time_s"] == pytest.approx(3.73, rel=0.05)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["bilstm", "axis_nn"])
 def test_estimate_with_the_linuxcnc_networks(program, capsys, method):
     # trained once from the shipped recordings (then loaded from data/cache/models)
@@ -283,7 +284,8 @@ def _profile_methods():
             learned = method in ("bilstm", "axis_nn")
             if learned and profile.recordings is None:
                 continue  # refused alike (test_ordinary_mistakes_give_one_line_and_exit_2)
-            yield name, method
+            # the networks train once on an empty cache
+            yield pytest.param(name, method, marks=[pytest.mark.slow] if learned else [])
 
 
 @pytest.mark.parametrize(("name", "method"), list(_profile_methods()))
@@ -305,6 +307,7 @@ def test_a_copied_profile_estimates_as_the_shipped_one(program, tmp_path, capsys
         assert code == 2 and err.startswith(f"nctwin: method {method!r} needs a control")
 
 
+@pytest.mark.slow
 def test_calibrate_writes_the_shipped_fir_control(tmp_path, capsys):
     """`nctwin calibrate` on the shipped recordings gives the [control.fir] that
     linuxcnc_sim.toml holds, with its provenance; nothing else in the file changes."""
@@ -348,6 +351,7 @@ def test_move_floors_by_hand():
     assert summary["clamped_to_floor"] == 3 and summary["floor_time_s"] == pytest.approx(20.7)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["bilstm", "axis_nn"])
 def test_learned_estimates_are_raised_to_the_floor(tmp_path, capsys, method):
     prog = tmp_path / "square.nc"

@@ -120,6 +120,7 @@ def test_claims_by_seed_reads_every_seed_beside_the_ensemble() -> None:
     assert table.set_index("id").loc["pocket", "seeds_holding"] == 2
 
 
+@pytest.mark.slow
 def test_seeds_train_in_parallel_with_the_sequential_bits(tmp_path, monkeypatch) -> None:
     from joblib.externals.loky import get_reusable_executor
 

@@ -230,6 +230,7 @@ def test_round_trip_parse_dump_parse(text):
 _GCODE_ALPHABET = "GXYZIJKRFPQLMSTNOgx0123456789.-+ \t\n()%;/#[]=é"
 
 
+@pytest.mark.slow
 @given(st.one_of(st.text(max_size=300), st.text(alphabet=_GCODE_ALPHABET, max_size=300)))
 def test_any_text_parses_or_raises_gcode_error(text):
     try:
@@ -242,6 +243,7 @@ def test_any_text_parses_or_raises_gcode_error(text):
         assert np.isfinite(tp.lengths_mm).all()
 
 
+@pytest.mark.slow
 @given(st.binary(max_size=300))
 def test_random_bytes_parse_or_raise_gcode_error(data):
     try:

@@ -26,6 +26,7 @@ def test_bad_worker_counts_are_named(n_jobs):
         run_tasks(_square, [(1,)], n_jobs=n_jobs)
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_local_bits(monkeypatch):
     # the chapter's simulations, as a sweep would send them: two programs on the FIR kernel
     distributed = pytest.importorskip("dask.distributed")

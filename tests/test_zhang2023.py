@@ -133,6 +133,7 @@ def _tiny_surface(seed: int) -> SimpleNamespace:
     return SimpleNamespace(x=x, y_um=(x[:, :1] ** 2 + 0.1 * x[:, 1:2]))
 
 
+@pytest.mark.slow
 def test_parallel_training_gives_the_sequential_bits(tmp_path, monkeypatch) -> None:
     from joblib.externals.loky import get_reusable_executor
 
