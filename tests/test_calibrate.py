@@ -18,6 +18,7 @@ from nctwin.calibrate import (
     span_s,
     write_profile,
 )
+from nctwin.cli import main
 from nctwin.controls import SequenceControl
 from nctwin.estimate import cam
 from nctwin.machine import Machine, Profile
@@ -153,3 +154,28 @@ def test_leave_one_program_out_table():
     assert table.shape == (9, 7)
     assert sorted(set(table["program"])) == keep
     assert table.groupby("program")["chosen"].sum().tolist() == [1, 1, 1]
+
+
+def test_calibrate_log_refuses_a_file_that_is_no_log(tmp_path, capsys):
+    bad = tmp_path / "notes.txt"
+    bad.write_text("these are notes\n")
+    assert main(["calibrate-log", str(bad), "--machine-name", "Hurco02", "--output",
+                 str(tmp_path / "p.toml")]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "notes.txt:1: not a 'timestamp|item|value' record" in err
+
+
+def test_calibrate_log_refuses_a_program_not_in_the_folder(tmp_path, capsys):
+    log = tmp_path / "other-Hurco02.txt"
+    log.write_text(
+        "2017-01-01T00:00:00.000000Z|Program_Name_Running|NOPE.NC\n"
+        "2017-01-01T00:00:01.000000Z|Program_Status|ACTIVE\n"
+        "2017-01-01T00:00:02.000000Z|Block_Number|3\n"
+        "2017-01-01T00:00:09.000000Z|Program_Status|PROGRAM_COMPLETED\n"
+    )
+    assert main(["calibrate-log", str(log), "--machine-name", "Hurco02", "--output",
+                 str(tmp_path / "p.toml")]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "no valid run of Hurco02 in 1 log(s); other-Hurco02.txt: unknown_program" in err
+    assert not (tmp_path / "p.toml").exists()

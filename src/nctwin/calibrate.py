@@ -216,23 +216,26 @@ def machine_runs(
     Raises
     ------
     ValueError
-        A file that is no log (:func:`nctwin.mtconnect.read_log`'s one line), or no valid run.
+        A file that is no log (:func:`nctwin.mtconnect.read_log`'s one line), or no valid run
+        (the first run's reason: a program not in the folder is ``unknown_program``).
     """
     folder = nist_dir()
     texts = {p.name: p.read_text() for p in sorted((folder / "nc").glob("*.NC"))}
     if log_paths is None:
         log_paths = sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz"))
-    out, programs = [], {}
+    out, programs, why = [], {}, []
     for path in map(Path, log_paths):
         for run in runs(read_log(path)):
             v = validate(run, texts)
             if not v.valid:
+                why.append(f"{path.name}: {v.reason} ({v.detail})")
                 continue
             if v.program not in programs:
                 programs[v.program] = program_lines(folder / "nc" / v.program)
             out.append(run_times(run, programs[v.program][0], v.rapid_plateau_mm_s, v.motion_s))
     if not out:
-        raise ValueError(f"no valid run of {machine_name} in {len(log_paths)} log(s)")
+        first = f"; {why[0]}" if why else ""
+        raise ValueError(f"no valid run of {machine_name} in {len(log_paths)} log(s){first}")
     return out, programs
 
 
