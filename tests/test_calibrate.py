@@ -148,7 +148,9 @@ def test_hurco02_rapid_and_determinism():
 @pytest.mark.slow
 def test_leave_one_program_out_table():
     times, programs = machine_runs("Hurco04")
-    keep = sorted({r.program for r in times})[:3]
+    # three plates whose runs show a rapid plateau (PLATE-12 and 13 show none: without them,
+    # no fold is left without a rapid feed)
+    keep = sorted({r.program for r in times if np.isfinite(r.rapid_mm_s)})[:3]
     times = [r for r in times if r.program in keep]
     table = leave_one_program_out("Hurco04", times, programs)
     assert table.shape == (9, 7)
