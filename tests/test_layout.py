@@ -24,7 +24,7 @@ LAYERS = (
     ("learn",),
     ("methods",),
     ("estimate",),
-    ("identify", "record"),
+    ("identify", "record", "calibrate"),
     ("chapters",),
     ("cli",),
 )

@@ -1,15 +1,17 @@
-"""The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines`` and ``calibrate``.
+"""The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines``, ``calibrate`` and
+``calibrate-log``.
 
-``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the
-machine profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR
-kernel (the profile's ``[control.fir]``) and can write the feed plot and the sampled motion;
-``nctwin machines`` lists the shipped machine profiles; ``nctwin calibrate`` fits a profile's
-control to its recordings and writes it into a profile file. ``-`` reads the program from standard
-input. Bad input ends with exit code 2 and one line on standard error, never a traceback:
-``file:line: reason`` for a line of the program that cannot be read (one such line per error
-the reader lists), ``file: reason`` for a file that is not a program (absent, a directory,
-binary, no motion), ``nctwin: reason`` for the rest (a bad machine profile or argument, an
-output file that cannot be written).
+``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the machine
+profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR kernel
+(the profile's ``[control.fir]``) and can write the feed plot and the sampled motion; ``nctwin
+machines`` lists the shipped machine profiles; ``nctwin calibrate`` fits a profile's control to
+its recordings and writes it into a profile file; ``nctwin calibrate-log LOG ...`` calibrates a
+real machine from its MTConnect logs (:mod:`nctwin.calibrate`). ``-`` reads the program from
+standard input. Bad input ends with exit code 2 and one line on standard error, never a
+traceback: ``file:line: reason`` for a line of the program that cannot be read (one such line
+per error the reader lists), ``file: reason`` for a file that is not a program (absent, a
+directory, binary, no motion), ``nctwin: reason`` for the rest (a bad machine profile or
+argument, an output file that cannot be written).
 """
 
 from __future__ import annotations
@@ -230,6 +232,17 @@ def _parser() -> argparse.ArgumentParser:
         metavar="TOML",
         help="profile file to write (the machine's own file, or a new one: a copy of it)",
     )
+    g = sub.add_parser(
+        "calibrate-log",
+        help="calibrate a real machine from its MTConnect logs, into a profile file",
+        description="Identify a machine's rapid feed, non-motion times and best motion model\n"
+        "from the valid runs in its MTConnect logs (programs from the NIST folder) and write\n"
+        "a profile file: [machine], the best control, [control.sequence].",
+        formatter_class=fmt,
+    )
+    g.add_argument("logs", nargs="+", metavar="LOG", help="MTConnect logs (.txt or .txt.gz)")
+    g.add_argument("--machine-name", required=True, help="the machine's name, e.g. Hurco02")
+    g.add_argument("--output", required=True, metavar="TOML", help="profile file to write")
     return p
 
 
@@ -533,6 +546,25 @@ def _calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _calibrate_log(args: argparse.Namespace) -> int:
+    from .calibrate import calibrate, machine_runs, write_profile
+
+    for log in args.logs:
+        if not Path(log).is_file():
+            raise ValueError(f"{log}: no such log file")
+    times, programs = machine_runs(args.machine_name, args.logs)
+    cal = calibrate(args.machine_name, times, programs)
+    write_profile(cal, args.output, today=date.today())
+    seq = cal.sequence
+    print(f"{args.machine_name}: {len(times)} valid runs of {len(programs)} programs")
+    print(f"rapid feed {cal.machine.rapid_feed_mm_s:.2f} mm/s; tool change "
+          f"{seq.tool_change_s:.2f} s; spindle start {seq.spindle_start_s:.2f} s + "
+          f"{seq.spindle_start_s_per_krpm:.3f} s per 1000 rev/min")  # fmt: skip
+    errs = ", ".join(f"{k} {v:.2f} %" for k, v in cal.fit_err_pct.items())
+    print(f"motion-time error on these runs: {errs}; best {cal.best}; wrote {args.output}")
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     try:
@@ -549,6 +581,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _simulate(args, enabled)
         if args.command == "calibrate":
             return _calibrate(args)
+        if args.command == "calibrate-log":
+            return _calibrate_log(args)
         return _estimate(args, enabled)
     except GCodeError as exc:
         print("\n".join(_gcode_lines(exc)), file=sys.stderr)

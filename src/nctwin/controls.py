@@ -12,6 +12,7 @@ kind          type                    used by
 ``accdec``    :class:`AccDecControl`  :mod:`nctwin.kernel.accdec`, ``--method block_overlap``
 ``fanuc``     :class:`FanucControl`   :mod:`nctwin.kernel.fanuc`
 ``planner``   :class:`PlannerControl` ``--method planner`` and the learned methods
+``sequence``  :class:`SequenceControl`  non-motion times (:mod:`nctwin.calibrate`)
 ============  ======================  ===================================================
 
 Each type owns its period, its time constants, its servo and in-position settings and its
@@ -34,6 +35,7 @@ __all__ = [
     "FanucControl",
     "FirControl",
     "PlannerControl",
+    "SequenceControl",
 ]
 
 _XYZ = tuple[float, float, float]
@@ -345,8 +347,48 @@ class PlannerControl:
         _check_tolerance(self.blend_tol_mm)
 
 
+@dataclass(frozen=True)
+class SequenceControl:
+    """What a control spends on lines that are no motion, as a real machine's logs time them
+    (:mod:`nctwin.calibrate`): net of the motion of the lines involved, which a motion model
+    times.
+
+    Parameters
+    ----------
+    tool_change_s : float
+        A tool change: from the ``G91 G28 Z0.`` before a ``Tn M6`` to the ``M6`` (an ``M01``
+        between them included), in [0, 600] s.
+    spindle_start_s, spindle_start_s_per_krpm : float
+        A spindle start (``S.. M3`` and the line after it) takes
+        ``spindle_start_s + spindle_start_s_per_krpm * S / 1000``; each in [-600, 600] (s, and
+        s per 1000 rev/min), the law's value at 0 rev/min may be negative.
+    optional_stop_s : float
+        An ``M01`` line outside a tool change, optional stop off, in [0, 600] s.
+    program_start_s, program_end_s : float
+        Cycle start to the first block; the M30 line to the end of the run; each in [0, 600] s.
+    """
+
+    tool_change_s: float = 0.0
+    spindle_start_s: float = 0.0
+    spindle_start_s_per_krpm: float = 0.0
+    optional_stop_s: float = 0.0
+    program_start_s: float = 0.0
+    program_end_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("tool_change_s", "optional_stop_s", "program_start_s", "program_end_s"):
+            check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
+        for name in ("spindle_start_s", "spindle_start_s_per_krpm"):
+            check_number(name, getattr(self, name), -600.0, 600.0, lo_closed=True,
+                         hi_closed=True)  # fmt: skip
+
+    def spindle_s(self, rpm: float) -> float:
+        """The time (s) of a spindle start to ``rpm`` rev/min."""
+        return self.spindle_start_s + self.spindle_start_s_per_krpm * rpm / 1000.0
+
+
 #: A control's settings, of any model.
-Control = FirControl | AccDecControl | FanucControl | PlannerControl
+Control = FirControl | AccDecControl | FanucControl | PlannerControl | SequenceControl
 
 #: The control models by the name of their table in a profile's file (``[control.<kind>]``).
 CONTROLS: dict[str, type] = {
@@ -354,4 +396,5 @@ CONTROLS: dict[str, type] = {
     "accdec": AccDecControl,
     "fanuc": FanucControl,
     "planner": PlannerControl,
+    "sequence": SequenceControl,
 }

@@ -3,7 +3,8 @@ estimate to trust, in one file (``data/machines/*.toml``).
 
 A profile's file has one ``[machine]`` table (:class:`Machine`: axis limits, rapid and maximum
 feed), one ``[control.<kind>]`` table per control model it is described for
-(:data:`nctwin.controls.CONTROLS`: ``fir``, ``accdec``, ``fanuc``, ``planner``), and two
+(:data:`nctwin.controls.CONTROLS`: ``fir``, ``accdec``, ``fanuc``, ``planner``,
+``sequence``), and two
 top-level keys: ``default_method``, the method ``nctwin estimate`` uses when none is named, and
 ``recordings``, the shipped recordings of this machine the learned methods train on (if any).
 No key is written twice, and an unknown or misspelt key is refused with the file, the table and
@@ -38,6 +39,7 @@ from .controls import (
     FanucControl,
     FirControl,
     PlannerControl,
+    SequenceControl,
 )
 from .paths import data_dir
 
@@ -123,7 +125,7 @@ class Profile:
     Parameters
     ----------
     machine : Machine
-    fir, accdec, fanuc, planner : control settings or None
+    fir, accdec, fanuc, planner, sequence : control settings or None
         The control models the profile describes (:data:`nctwin.controls.CONTROLS`); None
         for a model it does not.
     default_method : str
@@ -139,6 +141,7 @@ class Profile:
     accdec: AccDecControl | None = None
     fanuc: FanucControl | None = None
     planner: PlannerControl | None = None
+    sequence: SequenceControl | None = None
     default_method: str = "cam"
     recordings: str | None = None
 

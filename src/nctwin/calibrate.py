@@ -1,0 +1,490 @@
+r"""Calibrate one real machine from its MTConnect logs (:mod:`nctwin.mtconnect`): the rapid
+feed, the times that are no motion (tool changes, spindle starts, optional stops, the start and
+the end of a run), and the control model that times its motion best.
+
+The logs time a program's lines, not its motion: ``Block_Number`` names the line executing
+from then on, logged on change, so a short line may never show and a line's event may lag its
+start. The times are therefore read as spans between events (:func:`span_s`: from the first
+event at or past one line to the first past another), never as one line's duration, and every
+non-motion time is *net*: a span's time minus the CAM time of the span's own blocks at the
+identified rapid feed (what a motion estimator adds back when it times the same blocks).
+
+* **Tool change** (:attr:`SequenceControl.tool_change_s`): from the ``G91 G28 Z0.`` line
+  before a ``Tn M6`` line to the ``M6`` line, both included; the ``M01`` between them on every
+  shipped program is in it (optional stop off: a valid run has no pause), and so is the Z
+  travel to the real home above the program's ``G28`` point.
+* **Spindle start**: from the ``S.. M3`` line to the line after it, both included: the control
+  moves on only once the spindle is at speed. A constant where the calibration runs command
+  one speed, a line in the speed where they command several
+  (:attr:`SequenceControl.spindle_start_s_per_krpm`).
+* **Optional stop** (:attr:`SequenceControl.optional_stop_s`): an ``M01`` line outside a tool
+  change; none of the shipped programs has one, so it stays 0 ("not identified").
+* **Program start / end**: the run's start to its first block event; its M30 line's event to
+  the run's end (PROGRAM_COMPLETED).
+
+:func:`calibrate` fits them and the motion models on some runs, :func:`predict_runs` predicts
+``Verdict.motion_s`` of others, :func:`leave_one_program_out` does both with each program held
+out, :func:`write_profile` writes the machine's profile file.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .controls import FirControl, PlannerControl, SequenceControl
+from .estimate import cam, kernel
+from .estimate.blend_planner import blend_planner
+from .gcode import parse_file
+from .identify import fit_fir, fit_planner
+from .machine import Machine, write_control
+from .mtconnect import Run, read_log, runs, validate
+from .paths import nist_dir
+from .toolpath import Toolpath
+
+__all__ = [
+    "BASE_ACCELERATION_MM_S2",
+    "CALIBRATE_FIR_GRID",
+    "METHODS",
+    "Calibration",
+    "ProgramLines",
+    "RunTimes",
+    "calibrate",
+    "leave_one_program_out",
+    "machine_runs",
+    "predict_runs",
+    "program_lines",
+    "run_times",
+    "span_s",
+    "write_profile",
+]
+
+#: The motion estimators compared, by the profile's method names.
+METHODS = ("cam", "planner", "kernel")
+#: The FIR kernel's grid here: small, as a 30-minute program takes the kernel seconds.
+CALIBRATE_FIR_GRID = {"fir_t1_s": [0.03, 0.09], "fir_t2_s": [0.01],
+                      "fir_acc_scale": [0.25, 0.5, 1.0, 2.0], "fir_blend_ratio": [0.25],
+                      "fir_block_periods": [0]}  # fmt: skip
+#: The axis acceleration (mm/s^2) of the machine the FIR kernel scales (its ``acc_scale``).
+BASE_ACCELERATION_MM_S2 = 1000.0
+
+_G28 = re.compile(r"G0*28(?![0-9.])")
+_COMMENT = re.compile(r"\([^)]*\)")
+
+
+@dataclass(frozen=True)
+class ProgramLines:
+    """The lines of one program that :mod:`nctwin.calibrate` times (1-based file lines).
+
+    Parameters
+    ----------
+    file : str
+    first_cut, m30 : int
+        The first feed line (where ``Verdict.motion_s`` starts) and the M30 line.
+    tool_changes : numpy.ndarray
+        Shape (k, 2): the ``G28`` line before each ``M6`` line (the ``M6`` line itself where
+        none is within 3 lines) and the ``M6`` line.
+    spindle_starts : numpy.ndarray
+        Shape (m, 2): each line with ``M3``/``M4`` and the next line with a block.
+    spindle_rpm : numpy.ndarray
+        Shape (m,): the S word in force at each spindle start (rev/min).
+    optional_stops : numpy.ndarray
+        Shape (j,): ``M01`` lines outside every tool change.
+    """
+
+    file: str
+    first_cut: int
+    m30: int
+    tool_changes: np.ndarray
+    spindle_starts: np.ndarray
+    spindle_rpm: np.ndarray
+    optional_stops: np.ndarray
+
+
+def program_lines(path: str | Path) -> tuple[ProgramLines, Toolpath]:
+    """Read a program (:func:`nctwin.gcode.parse_file`) and find its timed lines."""
+    path = Path(path)
+    tp = parse_file(path)
+    text = path.read_text().split("\n")
+    g28 = [i for i, s in enumerate(text, 1) if _G28.search(_COMMENT.sub("", s.upper()))]
+    ev = tp.events
+    m = ev[ev["word"] == "M"]
+    block_lines = np.unique(tp.line)
+    changes = []
+    for line in m["line"][m["value"] == 6]:
+        before = [g for g in g28 if line - 3 <= g < line]
+        changes.append((before[0] if before else line, line))
+    changes_arr = np.array(changes, np.int64).reshape(-1, 2)
+    s_lines, rpm = ev["line"][ev["word"] == "S"], ev["value"][ev["word"] == "S"]
+    starts, speeds = [], []
+    for line in np.unique(m["line"][np.isin(m["value"], (3, 4))]):
+        nxt = block_lines[block_lines > line]
+        starts.append((line, nxt[0] if nxt.size else line))
+        speeds.append(rpm[s_lines <= line][-1] if (s_lines <= line).any() else 0.0)
+    stops = m["line"][m["value"] == 1]
+    inside = ((stops[:, None] >= changes_arr[:, 0]) & (stops[:, None] <= changes_arr[:, 1])).any(1)
+    is_cut = np.isin(tp.kind, (1, 2, 3))
+    first_cut = int(tp.line[is_cut][0]) if is_cut.any() else 0
+    m30 = m["line"][np.isin(m["value"], (2, 30))]
+    lines = ProgramLines(
+        path.name,
+        first_cut,
+        int(m30[0]) if m30.size else int(tp.line.max(initial=0)) + 1,
+        changes_arr,
+        np.array(starts, np.int64).reshape(-1, 2),
+        np.array(speeds, float),
+        np.asarray(stops[~inside], np.int64),
+    )
+    return lines, tp
+
+
+def span_s(block_t_s: np.ndarray, block: np.ndarray, first: int, last: int) -> float:
+    """Time (s) from the first block event at or past line ``first`` to the first past line
+    ``last`` (``block_t_s``, ``block``: shape (n,), a run's events; NaN where either is
+    missing)."""
+    a, b = np.flatnonzero(block >= first), np.flatnonzero(block > last)
+    if not a.size or not b.size:
+        return np.nan
+    return float(block_t_s[b[0]] - block_t_s[a[0]])
+
+
+@dataclass(frozen=True)
+class RunTimes:
+    """What one valid run's timeline shows (s, gross: the motion of the spans included).
+
+    Parameters
+    ----------
+    log, program : str
+    rapid_mm_s : float
+        ``Verdict.rapid_plateau_mm_s`` divided by the logged rapid override (NaN: no plateau).
+    motion_s : float
+        ``Verdict.motion_s``.
+    program_start_s, program_end_s : float
+        Start to the first block event; the M30 line's event to the end.
+    tool_change_s, spindle_start_s, optional_stop_s : numpy.ndarray
+        One span per tool change, spindle start, optional stop of the program (NaN where the
+        log shows no event for it), in :class:`ProgramLines` order.
+    """
+
+    log: str
+    program: str
+    rapid_mm_s: float
+    motion_s: float
+    program_start_s: float
+    program_end_s: float
+    tool_change_s: np.ndarray
+    spindle_start_s: np.ndarray
+    optional_stop_s: np.ndarray
+
+
+def run_times(run: Run, lines: ProgramLines, rapid_plateau_mm_s: float, motion_s: float):
+    """The :class:`RunTimes` of ``run`` on the program ``lines``."""
+    t, b = run.block_t_s, run.block
+    ro = run.rapid_override_pct.initial
+    ro = 100.0 if np.isnan(ro) else ro
+    return RunTimes(
+        run.log,
+        lines.file,
+        rapid_plateau_mm_s * 100.0 / ro,
+        motion_s,
+        float(t[0] - run.start_s),
+        float(run.end_s - t[-1]),
+        np.array([span_s(t, b, a, z) for a, z in lines.tool_changes]),
+        np.array([span_s(t, b, a, z) for a, z in lines.spindle_starts]),
+        np.array([span_s(t, b, a, a) for a in lines.optional_stops]),
+    )
+
+
+def machine_runs(
+    machine_name: str, log_paths: Sequence[str | Path] | None = None
+) -> tuple[list[RunTimes], dict[str, tuple[ProgramLines, Toolpath]]]:
+    """The valid runs of one machine in the logs (default: the shipped ones whose name holds
+    ``machine_name``) against the shipped programs (:func:`nctwin.paths.nist_dir`).
+
+    Returns
+    -------
+    runs : list of RunTimes
+    programs : dict of str to (ProgramLines, Toolpath)
+        The programs the runs ran, by file name.
+
+    Raises
+    ------
+    ValueError
+        A file that is no log (:func:`nctwin.mtconnect.read_log`'s one line), or no valid run
+        (the first run's reason: a program not in the folder is ``unknown_program``).
+    """
+    folder = nist_dir()
+    texts = {p.name: p.read_text() for p in sorted((folder / "nc").glob("*.NC"))}
+    if log_paths is None:
+        log_paths = sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz"))
+    out, programs, why = [], {}, []
+    for path in map(Path, log_paths):
+        for run in runs(read_log(path)):
+            v = validate(run, texts)
+            if not v.valid:
+                why.append(f"{path.name}: {v.reason} ({v.detail})")
+                continue
+            if v.program not in programs:
+                programs[v.program] = program_lines(folder / "nc" / v.program)
+            out.append(run_times(run, programs[v.program][0], v.rapid_plateau_mm_s, v.motion_s))
+    if not out:
+        first = f"; {why[0]}" if why else ""
+        raise ValueError(f"no valid run of {machine_name} in {len(log_paths)} log(s){first}")
+    return out, programs
+
+
+def _machine(name: str, rapid_mm_s: float) -> Machine:
+    """A machine of the identified rapid feed (every axis at it) and a generic acceleration."""
+    return Machine(
+        name=name,
+        description=f"{name}, calibrated from its MTConnect logs (nctwin.calibrate)",
+        axis_max_velocity_mm_s=(rapid_mm_s,) * 3,
+        axis_max_acceleration_mm_s2=(BASE_ACCELERATION_MM_S2,) * 3,
+        axis_max_jerk_mm_s3=(np.inf,) * 3,
+        rapid_feed_mm_s=rapid_mm_s,
+        max_feed_mm_s=rapid_mm_s,
+    )
+
+
+def _span_blocks(tp: Toolpath, spans: np.ndarray) -> list[np.ndarray]:
+    """Per span (shape (k, 2), lines), the mask of ``tp``'s blocks within it."""
+    return [(tp.line >= a) & (tp.line <= z) for a, z in spans]
+
+
+def _window(tp: Toolpath, lines: ProgramLines) -> np.ndarray:
+    """Mask of the blocks ``Verdict.motion_s`` times: the first cut's line to the M30's."""
+    return (tp.line >= lines.first_cut) & (tp.line < lines.m30)
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """One machine calibrated on some of its runs (:func:`calibrate`).
+
+    Parameters
+    ----------
+    machine : Machine
+        Every axis and the rapid at the identified rapid feed.
+    rapid_mm_s : numpy.ndarray
+        Shape (n,): each calibration run's rapid plateau / its logged rapid override (NaN: no
+        plateau); ``machine.rapid_feed_mm_s`` is their median.
+    sequence : SequenceControl
+        The non-motion times.
+    residuals_s : dict of str to numpy.ndarray
+        Measured minus fitted, per non-motion time (``tool_change``, ``spindle_start``,
+        ``optional_stop``, ``program_start``, ``program_end``).
+    planner, fir : PlannerControl, FirControl
+        The fitted controls (the planner's axis limits are in ``planner_machine``).
+    planner_machine : Machine
+    fit_err_pct : dict of str to float
+        Per method, the mean absolute error (%) of the motion time on the calibration runs.
+    best : str
+        The method of the least ``fit_err_pct``.
+    runs : tuple of str
+        The calibration runs' logs.
+    """
+
+    machine: Machine
+    rapid_mm_s: np.ndarray
+    sequence: SequenceControl
+    residuals_s: dict
+    planner: PlannerControl
+    planner_machine: Machine
+    fir: FirControl
+    fit_err_pct: dict
+    best: str
+    runs: tuple
+
+
+def _sequence_s(lines: ProgramLines, seq: SequenceControl) -> float:
+    """The non-motion time ``seq`` gives the motion window of a program (s)."""
+    after = lines.spindle_starts[:, 0] >= lines.first_cut
+    tc = lines.tool_changes[:, 0] >= lines.first_cut
+    spindle = sum(seq.spindle_s(rpm) for rpm in lines.spindle_rpm[after])
+    stops = lines.optional_stops.size * seq.optional_stop_s
+    return float(tc.sum() * seq.tool_change_s + spindle + stops)
+
+
+def _motion_s(method: str, tp: Toolpath, machine: Machine, cal: Calibration) -> float:
+    """The motion time (s) of ``tp`` by ``method`` with ``cal``'s fitted controls."""
+    if method == "cam":
+        return cam(tp, machine).cycle_time_s
+    if method == "planner":
+        return blend_planner(tp, cal.planner_machine, cal.planner).cycle_time_s
+    return kernel(tp, machine, cal.fir).cycle_time_s
+
+
+def calibrate(
+    name: str, times: Sequence[RunTimes], programs: dict, *, n_jobs: int = 2
+) -> Calibration:
+    """Identify the rapid feed, the non-motion times and the motion models from ``times``.
+
+    Non-motion times are medians of the net spans (the module docstring), the spindle start a
+    least-squares line in the commanded speed where the runs command two speeds or more. The
+    planner's axis limits are fitted by :func:`nctwin.identify.fit_planner`, the FIR kernel by
+    :func:`nctwin.identify.fit_fir` on :data:`CALIBRATE_FIR_GRID`, each on the median motion
+    time (minus the non-motion times) of each program; the best method is the one of least
+    mean absolute error on these same runs.
+    """
+    rapid = np.array([r.rapid_mm_s for r in times])
+    if not np.isfinite(rapid).any():
+        raise ValueError(f"no run of {name} shows a rapid plateau: the rapid feed is unknown")
+    machine = _machine(name, float(np.nanmedian(rapid)))
+    net: dict[str, list] = {"tool_change": [], "spindle_start": [], "optional_stop": []}
+    rpm: list[float] = []
+    for r in times:
+        lines, tp = programs[r.program]
+        blocks = cam(tp, machine).block_times_s
+        for key, spans, gross in (
+            ("tool_change", lines.tool_changes, r.tool_change_s),
+            ("spindle_start", lines.spindle_starts, r.spindle_start_s),
+            ("optional_stop", np.c_[lines.optional_stops, lines.optional_stops], r.optional_stop_s),
+        ):
+            inside = spans[:, 0] >= lines.first_cut  # the window's: the others are the start's
+            motion = np.array([blocks[m].sum() for m in _span_blocks(tp, spans[inside])])
+            net[key] += list(gross[inside] - motion)
+        rpm += list(lines.spindle_rpm[lines.spindle_starts[:, 0] >= lines.first_cut])
+    rpm_arr = np.asarray(rpm)
+    residuals = {}
+    med = {k: np.array(v) for k, v in net.items()}
+    ok = np.isfinite(med["spindle_start"])
+    if np.unique(rpm_arr[ok]).size >= 2:
+        slope, icpt = np.polyfit(rpm_arr[ok] / 1000.0, med["spindle_start"][ok], 1)
+    else:
+        slope, icpt = 0.0, float(np.nanmedian(med["spindle_start"]))
+    residuals["spindle_start"] = med["spindle_start"][ok] - (icpt + slope * rpm_arr[ok] / 1000.0)
+    fitted = {}
+    for key in ("tool_change", "optional_stop"):
+        v = med[key][np.isfinite(med[key])]
+        fitted[key] = float(np.median(v)) if v.size else 0.0
+        residuals[key] = v - fitted[key]
+    for key in ("program_start", "program_end"):
+        v = np.array([getattr(r, f"{key}_s") for r in times])
+        fitted[key] = float(np.median(v))
+        residuals[key] = v - fitted[key]
+    seq = SequenceControl(
+        tool_change_s=fitted["tool_change"],
+        spindle_start_s=float(icpt),
+        spindle_start_s_per_krpm=float(slope),
+        optional_stop_s=fitted["optional_stop"],
+        program_start_s=fitted["program_start"],
+        program_end_s=fitted["program_end"],
+    )
+    logs = tuple(r.log for r in times)
+    pairs = []
+    for file in sorted({r.program for r in times}):
+        lines, tp = programs[file]
+        measured = np.median([r.motion_s for r in times if r.program == file])
+        pairs.append((tp.take(_window(tp, lines)), measured - _sequence_s(lines, seq)))
+    planner = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
+    pfit = fit_planner(pairs, machine, planner)
+    fir, _ = fit_fir(pairs, machine, FirControl(period_s=0.002, blend_tol_mm=0.0254),
+                     CALIBRATE_FIR_GRID, n_jobs=n_jobs)  # fmt: skip
+    cal = Calibration(machine, rapid, seq, residuals, planner, pfit.machine, fir, {}, "cam",
+                      logs)  # fmt: skip
+    err = {}
+    for method in METHODS:
+        sim = np.array([_motion_s(method, tp, machine, cal) for tp, _ in pairs])
+        target = np.array([t for _, t in pairs])
+        err[method] = float(np.mean(np.abs(sim / target - 1)) * 100)
+    best = min(err, key=err.get)
+    return Calibration(machine, rapid, seq, residuals, planner, pfit.machine, fir, err, best,
+                       logs)  # fmt: skip
+
+
+def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) -> pd.DataFrame:
+    """Predicted ``motion_s`` of each run by each of :data:`METHODS` (motion plus
+    ``cal.sequence``): a row per run and method, ``log``, ``program``, ``method``,
+    ``measured_s``, ``predicted_s``, ``error_pct``."""
+    rows = []
+    cache: dict = {}
+    for r in times:
+        lines, tp = programs[r.program]
+        for method in METHODS:
+            key = (r.program, method)
+            if key not in cache:
+                window = tp.take(_window(tp, lines))
+                cache[key] = _motion_s(method, window, cal.machine, cal) + _sequence_s(
+                    lines, cal.sequence
+                )
+            rows.append({"log": r.log, "program": r.program, "method": method,
+                         "measured_s": r.motion_s, "predicted_s": cache[key],
+                         "error_pct": 100 * (cache[key] / r.motion_s - 1)})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def leave_one_program_out(
+    name: str, times: Sequence[RunTimes], programs: dict, *, n_jobs: int = 2
+) -> pd.DataFrame:
+    """Each program's runs predicted by a calibration on the other programs' runs.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per held-out program and method: ``program``, ``method``, ``runs``,
+        ``median_measured_s``, ``predicted_s``, ``error_pct`` (signed, against the median of
+        the program's runs), ``chosen`` (the method the calibration picked on its own runs).
+    """
+    rows = []
+    for file in sorted({r.program for r in times}):
+        train = [r for r in times if r.program != file]
+        test = [r for r in times if r.program == file]
+        cal = calibrate(name, train, programs, n_jobs=n_jobs)
+        pred = predict_runs(cal, test, programs)
+        for method, g in pred.groupby("method", sort=False):
+            measured = float(g["measured_s"].median())
+            predicted = float(g["predicted_s"].iloc[0])
+            rows.append({"program": file, "method": method, "runs": len(g),
+                         "median_measured_s": measured, "predicted_s": predicted,
+                         "error_pct": 100 * (predicted / measured - 1),
+                         "chosen": method == cal.best})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def _residual_text(res: np.ndarray) -> str:
+    if not res.size:
+        return "none"
+    return f"{res.size} spans, s.d. {np.std(res):.2f} s, worst {np.max(np.abs(res)):.2f} s"
+
+
+def _vec(v) -> str:
+    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+
+def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
+    """Write ``cal`` as a profile file: ``[machine]``, ``default_method`` (``cal.best``), the
+    best method's control table and ``[control.sequence]``, each with its provenance."""
+    m = cal.machine if cal.best != "planner" else cal.planner_machine
+    out = Path(output)
+    out.write_text(
+        f"# {m.name}, calibrated from {len(cal.runs)} valid runs of its MTConnect logs\n"
+        f"# (nctwin.calibrate): rapid feed the median rapid plateau over "
+        f"{np.isfinite(cal.rapid_mm_s).sum()} runs.\n"
+        f'default_method = "{cal.best}"\n\n[machine]\n'
+        f'name = "{m.name}"\ndescription = "{m.description}"\n'
+        f"axis_max_velocity_mm_s = {_vec(m.axis_max_velocity_mm_s)}\n"
+        f"axis_max_acceleration_mm_s2 = {_vec(m.axis_max_acceleration_mm_s2)}\n"
+        "axis_max_jerk_mm_s3 = [inf, inf, inf]\n"
+        f"rapid_feed_mm_s = {m.rapid_feed_mm_s!r}\nmax_feed_mm_s = {m.max_feed_mm_s!r}\n"
+    )
+    runs_text = f"{len(cal.runs)} runs ({cal.runs[0]} ... {cal.runs[-1]})"
+    fit = ", ".join(f"{k} {v:.2f} %" for k, v in cal.fit_err_pct.items())
+    if cal.best != "cam":
+        kind = "planner" if cal.best == "planner" else "fir"
+        control = cal.planner if kind == "planner" else cal.fir
+        write_control(out, kind, control, [
+            f"Fitted by nctwin.calibrate on the motion times of {runs_text}.",
+            f"Mean absolute motion-time error on them: {fit}."], today=today)  # fmt: skip
+    res = cal.residuals_s
+    write_control(out, "sequence", cal.sequence, [
+        f"Non-motion times from the block events of {runs_text} (nctwin.calibrate).",
+        f"Residuals: tool change {_residual_text(res['tool_change'])}; spindle start "
+        f"{_residual_text(res['spindle_start'])};",
+        f"program start {_residual_text(res['program_start'])}; program end "
+        f"{_residual_text(res['program_end'])}; optional stop "
+        f"{_residual_text(res['optional_stop'])}."], today=today)  # fmt: skip
