@@ -164,7 +164,8 @@ record: venv linuxcnc
 
 # calibrate: what is fitted to the recordings is written into the machine's profile file (with a
 # comment that says which recordings, when, and the residual), never read from results/ at run
-# time. After `make record`, run this and commit the profile.
+# time. After `make record`, run this and commit the profile. (A real machine's profile comes
+# from its MTConnect logs: nctwin calibrate LOG ... --output PROFILE.toml.)
 calibrate: venv
 	@t0=$$(date +%s); $(VENV)/bin/nctwin calibrate --recordings linuxcnc --machine linuxcnc_sim \
 	  --output data/machines/linuxcnc_sim.toml; \

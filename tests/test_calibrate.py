@@ -158,16 +158,15 @@ def test_leave_one_program_out_table():
     assert table.groupby("program")["chosen"].sum().tolist() == [1, 1, 1]
 
 
-def test_calibrate_log_refuses_a_file_that_is_no_log(tmp_path, capsys):
+def test_calibrate_refuses_a_file_that_is_no_log(tmp_path, capsys):
     bad = tmp_path / "notes.txt"
     bad.write_text("these are notes\n")
-    assert main(["calibrate-log", str(bad), "--machine-name", "Hurco02", "--output",
-                 str(tmp_path / "p.toml")]) == 2  # fmt: skip
+    assert main(["calibrate", str(bad), "--output", str(tmp_path / "hurco02.toml")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "notes.txt:1: not a 'timestamp|item|value' record" in err
 
 
-def test_calibrate_log_refuses_a_program_not_in_the_folder(tmp_path, capsys):
+def test_calibrate_refuses_a_program_not_in_the_folder(tmp_path, capsys):
     log = tmp_path / "other-Hurco02.txt"
     log.write_text(
         "2017-01-01T00:00:00.000000Z|Program_Name_Running|NOPE.NC\n"
@@ -175,9 +174,26 @@ def test_calibrate_log_refuses_a_program_not_in_the_folder(tmp_path, capsys):
         "2017-01-01T00:00:02.000000Z|Block_Number|3\n"
         "2017-01-01T00:00:09.000000Z|Program_Status|PROGRAM_COMPLETED\n"
     )
-    assert main(["calibrate-log", str(log), "--machine-name", "Hurco02", "--output",
-                 str(tmp_path / "p.toml")]) == 2  # fmt: skip
+    out = tmp_path / "Hurco02.toml"
+    assert main(["calibrate", str(log), "--programs", str(tmp_path), "--output", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "no valid run of Hurco02 in 1 log(s); other-Hurco02.txt: unknown_program" in err
-    assert not (tmp_path / "p.toml").exists()
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--recordings", "linuxcnc", "x.log"], "give MTConnect logs or --recordings, not both"),
+        (["--recordings", "linuxcnc"], "give MTConnect logs, or --recordings NAME --machine"),
+        (["{log}", "--programs", "/no/such/dir"], "--programs /no/such/dir: no such folder"),
+    ],
+)
+def test_calibrate_refuses_a_wrong_combination(tmp_path, capsys, args, message):
+    log = tmp_path / "a.txt"
+    log.write_text("")
+    args = [a.replace("{log}", str(log)) for a in args]
+    assert main(["calibrate", *args, "--output", str(tmp_path / "p.toml")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"nctwin: {message}") and err.count("\n") == 1

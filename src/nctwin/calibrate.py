@@ -202,10 +202,13 @@ def run_times(run: Run, lines: ProgramLines, rapid_plateau_mm_s: float, motion_s
 
 
 def machine_runs(
-    machine_name: str, log_paths: Sequence[str | Path] | None = None
+    machine_name: str,
+    log_paths: Sequence[str | Path] | None = None,
+    programs_dir: str | Path | None = None,
 ) -> tuple[list[RunTimes], dict[str, tuple[ProgramLines, Toolpath]]]:
     """The valid runs of one machine in the logs (default: the shipped ones whose name holds
-    ``machine_name``) against the shipped programs (:func:`nctwin.paths.nist_dir`).
+    ``machine_name``) against the programs of ``programs_dir`` (``*.NC``; default the shipped
+    ones, :func:`nctwin.paths.nist_dir`).
 
     Returns
     -------
@@ -220,7 +223,8 @@ def machine_runs(
         (the first run's reason: a program not in the folder is ``unknown_program``).
     """
     folder = nist_dir()
-    texts = {p.name: p.read_text() for p in sorted((folder / "nc").glob("*.NC"))}
+    nc = folder / "nc" if programs_dir is None else Path(programs_dir)
+    texts = {p.name: p.read_text() for p in sorted(nc.glob("*.NC"))}
     if log_paths is None:
         log_paths = sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz"))
     out, programs, why = [], {}, []
@@ -231,7 +235,7 @@ def machine_runs(
                 why.append(f"{path.name}: {v.reason} ({v.detail})")
                 continue
             if v.program not in programs:
-                programs[v.program] = program_lines(folder / "nc" / v.program)
+                programs[v.program] = program_lines(nc / v.program)
             out.append(run_times(run, programs[v.program][0], v.rapid_plateau_mm_s, v.motion_s))
     if not out:
         first = f"; {why[0]}" if why else ""

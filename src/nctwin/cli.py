@@ -1,12 +1,11 @@
-"""The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines``, ``calibrate`` and
-``calibrate-log``.
+"""The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines`` and ``calibrate``.
 
 ``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the machine
 profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR kernel
 (the profile's ``[control.fir]``) and can write the feed plot and the sampled motion; ``nctwin
 machines`` lists the shipped machine profiles; ``nctwin calibrate`` fits a profile's control to
-its recordings and writes it into a profile file; ``nctwin calibrate-log LOG ...`` calibrates a
-real machine from its MTConnect logs (:mod:`nctwin.calibrate`). ``-`` reads the program from
+its recordings, or a real machine to its MTConnect logs (:mod:`nctwin.calibrate`), and writes it
+into a profile file. ``-`` reads the program from
 standard input. Bad input ends with exit code 2 and one line on standard error, never a
 traceback: ``file:line: reason`` for a line of the program that cannot be read (one such line
 per error the reader lists), ``file: reason`` for a file that is not a program (absent, a
@@ -85,7 +84,8 @@ examples:
   cat part.nc | nctwin estimate -"""
 
 CALIBRATE_EXAMPLES = """\
-example:
+examples:
+  nctwin calibrate Box-OP*-Hurco02-*.txt.gz --programs nc/ --output hurco02.toml
   nctwin calibrate --recordings linuxcnc --machine linuxcnc_sim \\
       --output data/machines/linuxcnc_sim.toml      (make calibrate)"""
 
@@ -209,40 +209,36 @@ def _parser() -> argparse.ArgumentParser:
 
     c = sub.add_parser(
         "calibrate",
-        help="fit a machine's FIR control to its recordings, into a profile file",
-        description="Fit the FIR kernel's settings to a machine's shipped recordings (a grid\n"
-        "search on recorded cycle times) and write them as the [control.fir] table of a\n"
-        "profile file, with a comment that says which recordings, when, and the residual.",
+        help="calibrate a machine from its logs or recordings, into a profile file",
+        description="Calibrate a machine into a profile file, with a comment that says what it\n"
+        "was fitted to, when, and the residual.\n"
+        "From MTConnect logs: the valid runs of one machine give its rapid feed, its\n"
+        "non-motion times ([control.sequence]) and the motion model that fits them best.\n"
+        "From shipped recordings (--recordings): the FIR kernel's [control.fir].",
         epilog=CALIBRATE_EXAMPLES,
         formatter_class=fmt,
     )
+    c.add_argument("logs", nargs="*", metavar="LOG", help="MTConnect logs of one machine "
+                   "(.txt or .txt.gz)")  # fmt: skip
+    c.add_argument(
+        "--programs",
+        metavar="DIR",
+        help="folder of the programs the logs ran (default: the shipped NIST programs)",
+    )
     c.add_argument(
         "--recordings",
-        required=True,
-        help="name of the shipped recordings the profile names (its recordings key)",
+        help="instead of logs: the shipped recordings the profile names (its recordings key)",
     )
     c.add_argument(
         "--machine",
-        required=True,
-        help="shipped profile name or .toml path of the recorded machine",
+        help="with --recordings: shipped profile name or .toml path of the recorded machine",
     )
     c.add_argument(
         "--output",
         required=True,
         metavar="TOML",
-        help="profile file to write (the machine's own file, or a new one: a copy of it)",
+        help="profile file to write (its name, without .toml, names the machine for logs)",
     )
-    g = sub.add_parser(
-        "calibrate-log",
-        help="calibrate a real machine from its MTConnect logs, into a profile file",
-        description="Identify a machine's rapid feed, non-motion times and best motion model\n"
-        "from the valid runs in its MTConnect logs (programs from the NIST folder) and write\n"
-        "a profile file: [machine], the best control, [control.sequence].",
-        formatter_class=fmt,
-    )
-    g.add_argument("logs", nargs="+", metavar="LOG", help="MTConnect logs (.txt or .txt.gz)")
-    g.add_argument("--machine-name", required=True, help="the machine's name, e.g. Hurco02")
-    g.add_argument("--output", required=True, metavar="TOML", help="profile file to write")
     return p
 
 
@@ -531,6 +527,12 @@ def _gcode_lines(exc: GCodeError) -> list[str]:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
+    if args.logs and args.recordings:
+        raise ValueError("give MTConnect logs or --recordings, not both")
+    if args.logs:
+        return _calibrate_logs(args)
+    if not (args.recordings and args.machine):
+        raise ValueError("give MTConnect logs, or --recordings NAME --machine PROFILE")
     from .identify import calibrate_fir
 
     profile = load_profile(args.machine)
@@ -546,17 +548,20 @@ def _calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _calibrate_log(args: argparse.Namespace) -> int:
+def _calibrate_logs(args: argparse.Namespace) -> int:
     from .calibrate import calibrate, machine_runs, write_profile
 
     for log in args.logs:
         if not Path(log).is_file():
             raise ValueError(f"{log}: no such log file")
-    times, programs = machine_runs(args.machine_name, args.logs)
-    cal = calibrate(args.machine_name, times, programs)
+    if args.programs is not None and not Path(args.programs).is_dir():
+        raise ValueError(f"--programs {args.programs}: no such folder")
+    name = Path(args.output).stem
+    times, programs = machine_runs(name, args.logs, args.programs)
+    cal = calibrate(name, times, programs)
     write_profile(cal, args.output, today=date.today())
     seq = cal.sequence
-    print(f"{args.machine_name}: {len(times)} valid runs of {len(programs)} programs")
+    print(f"{name}: {len(times)} valid runs of {len(programs)} programs")
     print(f"rapid feed {cal.machine.rapid_feed_mm_s:.2f} mm/s; tool change "
           f"{seq.tool_change_s:.2f} s; spindle start {seq.spindle_start_s:.2f} s + "
           f"{seq.spindle_start_s_per_krpm:.3f} s per 1000 rev/min")  # fmt: skip
@@ -581,8 +586,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _simulate(args, enabled)
         if args.command == "calibrate":
             return _calibrate(args)
-        if args.command == "calibrate-log":
-            return _calibrate_log(args)
         return _estimate(args, enabled)
     except GCodeError as exc:
         print("\n".join(_gcode_lines(exc)), file=sys.stderr)
