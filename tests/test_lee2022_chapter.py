@@ -46,8 +46,10 @@ def test_unknown_program_and_unmodelled_constructs_are_refused():
 
 
 def test_parameter_sets_are_the_papers():
-    for s, want in ((1, (0.15, 0.03, 0.05)), (2, (0.1, 0.02, 0.1))):
-        for c in SETS[s]:
+    # each set's (ATR, As, AT) as data/papers/lee2022_validation.csv transcribes them, in ms
+    for row in PAPER.itertuples():
+        want = (row.atr_ms / 1000, row.as_ms / 1000, row.at_ms / 1000)
+        for c in SETS[row.param_set]:
             assert (c.rapid_time_constant_s, c.rapid_bell_s, c.cut_time_constant_s) == want
     # the profile's [control.fanuc] table is the testbed the defaults describe, its
     # [control.accdec] table the estimator's set 1

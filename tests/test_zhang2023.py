@@ -61,10 +61,11 @@ def test_variant_and_finetuning_train_to_convergence() -> None:
     model, cfg = zh.variant_configs(325, dropout=0.5)
     assert model.dropout == 0.5 and model.weight_init == "uniform"
     # the paper's 2000 epochs are the cap; early stopping ends the training
-    assert (cfg.max_epochs, cfg.patience, cfg.learning_rate) == (2000, zh.PAPER_PATIENCE, 1e-2)
+    epochs = load_paper_table("zhang2023_summary").set_index("quantity")["value"]["epochs"]
+    assert (cfg.max_epochs, cfg.patience, cfg.learning_rate) == (epochs, zh.PAPER_PATIENCE, 1e-2)
     _, ft = zh.finetune_configs(325, seed=3)
     assert (ft.learning_rate, ft.max_epochs, ft.seed) == (3e-3, zh.FINETUNE_EPOCHS, 3)
-    assert replace(ft, learning_rate=1e-2, max_epochs=2000) == replace(cfg, seed=3)  # otherwise
+    assert replace(ft, learning_rate=1e-2, max_epochs=cfg.max_epochs) == replace(cfg, seed=3)
     _, tiny = zh.variant_configs(325, max_epochs=3)
     assert tiny.patience == 3
     for bad in ({"patience": 0}, {"max_epochs": 0}):
@@ -73,9 +74,14 @@ def test_variant_and_finetuning_train_to_convergence() -> None:
 
 
 def test_paper_configs_batches() -> None:
+    paper = load_paper_table("zhang2023_summary").set_index("quantity")["value"]
     model, full = zh.paper_configs(325)
-    assert model.dropout == 0.5 and model.weight_init == "normal"
-    assert full.learning_rate == 1e-5 and full.momentum == 0.8 and full.max_epochs == 2000
+    assert model.dropout == paper["dropout_p"] and model.weight_init == "normal"
+    assert (full.learning_rate, full.momentum, full.max_epochs) == (
+        paper["learning_rate"],
+        paper["momentum"],
+        paper["epochs"],
+    )
     # early stopping, the paper's 2000 epochs as the cap
     assert full.patience == zh.PAPER_PATIENCE == 100
     _, one = zh.paper_configs(325, batch_rows=1, dropout=0.0, epochs=1)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable
 
@@ -22,11 +23,9 @@ def check_range(
     name: str, value: float, low: float, high: float = np.inf, *, low_open: bool = False
 ) -> None:
     """Raise ValueError naming ``name``, its value and the allowed interval unless
-    ``low <= value <= high`` (``low < value`` with ``low_open``)."""
-    ok = (value > low if low_open else value >= low) and value <= high
-    if not ok:
-        bracket = "(" if low_open else "["
-        raise ValueError(f"{name} = {value!r} is out of range: allowed {bracket}{low}, {high}]")
+    ``low <= value <= high`` (``low < value`` with ``low_open``): :func:`check_number` with a
+    closed upper end."""
+    check_number(name, value, low, high, lo_closed=not low_open, hi_closed=True)
 
 
 def check_number(
@@ -40,8 +39,15 @@ def check_number(
     allow_inf: bool = False,
 ) -> None:
     """Raise ValueError naming ``name``, its value and the allowed interval unless ``value`` is
-    a real number (not a bool, not NaN) in it; ``allow_inf`` also admits ``inf``."""
-    ok = isinstance(value, int | float) and not isinstance(value, bool) and not math.isnan(value)
+    a real number (numpy's too; not a bool, not NaN) in it; ``allow_inf`` also admits ``inf``.
+
+    >>> check_number("feed_mm_s", 0.0, 0.0, 1000.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: feed_mm_s = 0.0 is out of range: allowed (0, 1000)
+    """
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+    ok = ok and not math.isnan(value)
     if ok and not (allow_inf and value == math.inf):
         ok = (lo <= value if lo_closed else lo < value) and (
             value <= hi if hi_closed else value < hi

@@ -34,6 +34,8 @@ from functools import cached_property
 import numpy as np
 from scipy import optimize
 
+from ..checks import check_number
+
 __all__ = [
     "PAPER_SURFACES",
     "BumpSurface",
@@ -48,11 +50,6 @@ __all__ = [
 #: the points :math:`c(u)`, :math:`c_u` and :math:`c_{uu}` of the iso-``v[rows]`` curves at ``u``
 #: (one per row), each shape (len(u), 3).
 CurveJet = Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray]]
-
-
-def _check_positive(name: str, value: float) -> None:
-    if not (np.isfinite(value) and value > 0):
-        raise ValueError(f"{name} = {value!r} is out of range: allowed > 0")
 
 
 @dataclass(frozen=True)
@@ -81,15 +78,15 @@ class BumpSurface:
 
     def __post_init__(self) -> None:
         for name in ("size_x_mm", "size_y_mm", "size_z_mm"):
-            _check_positive(name, getattr(self, name))
+            check_number(name, getattr(self, name), 0.0, np.inf)
         if not self.bumps or any(len(b) != 5 for b in self.bumps):
             raise ValueError(
                 f"bumps = {self.bumps!r} is out of range: allowed a non-empty tuple of "
                 "(x, y, sigma_x, sigma_y, weight)"
             )
         for b in self.bumps:
-            _check_positive("bump sigma_x", b[2])
-            _check_positive("bump sigma_y", b[3])
+            check_number("bump sigma_x", b[2], 0.0, np.inf)
+            check_number("bump sigma_y", b[3], 0.0, np.inf)
         if all(b[4] == 0 for b in self.bumps):
             raise ValueError(f"bumps = {self.bumps!r} is out of range: allowed a non-zero weight")
 
@@ -222,8 +219,8 @@ class Sphere:
     sweep_rad: float = 1.2
 
     def __post_init__(self) -> None:
-        _check_positive("radius_mm", self.radius_mm)
-        _check_positive("sweep_rad", self.sweep_rad)
+        check_number("radius_mm", self.radius_mm, 0.0, np.inf)
+        check_number("sweep_rad", self.sweep_rad, 0.0, np.inf)
 
     def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points and unit normals on the tool's side, each shape ``(*u.shape, 3)``."""
@@ -283,9 +280,9 @@ class Cylinder:
     sweep_rad: float = 2.0
 
     def __post_init__(self) -> None:
-        _check_positive("radius_mm", self.radius_mm)
-        _check_positive("length_mm", self.length_mm)
-        _check_positive("sweep_rad", self.sweep_rad)
+        check_number("radius_mm", self.radius_mm, 0.0, np.inf)
+        check_number("length_mm", self.length_mm, 0.0, np.inf)
+        check_number("sweep_rad", self.sweep_rad, 0.0, np.inf)
 
     def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points and unit normals on the tool's side, each shape ``(*u.shape, 3)``."""
@@ -410,7 +407,7 @@ def iso_parametric_path(
         raise ValueError(f"n_lines = {n_lines!r} is out of range: allowed >= 1")
     if n_points < 2:
         raise ValueError(f"n_points = {n_points!r} is out of range: allowed >= 2")
-    _check_positive("tool_radius_mm", tool_radius_mm)
+    check_number("tool_radius_mm", tool_radius_mm, 0.0, np.inf)
     u = np.linspace(0.0, 1.0, n_points)
     v = np.linspace(0.0, 1.0, n_lines)
     cc, normal = surface.point_normal(*np.meshgrid(u, v))
