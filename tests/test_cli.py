@@ -534,3 +534,68 @@ def test_tool_table_gives_the_tools_of_a_programs_t_words(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["reader"] == "linuxcnc"
     assert main(["estimate", str(prog), "--tool-table", str(tmp_path / "none.tbl")]) == 2
     assert capsys.readouterr().err.strip() == f"{tmp_path / 'none.tbl'}: no such tool table file"
+
+
+# --- cycle time: [control.sequence], motion time, breakdown, overrides --------------------------
+
+SEQUENCE_TABLE = """
+[control.sequence]
+tool_change_s = 9.5
+spindle_start_s = 1.0
+spindle_start_s_per_krpm = 0.3
+optional_stop_s = 2.0
+program_start_s = 1.5
+program_end_s = 3.0
+"""
+
+
+def test_a_nist_plate_with_a_sequence_table(tmp_path, capsys):
+    from nctwin.machine import profile_path
+    from nctwin.paths import nist_dir
+
+    machine = tmp_path / "with_sequence.toml"
+    machine.write_text(profile_path("generic_mill").read_text() + SEQUENCE_TABLE)
+    plate = str(nist_dir() / "nc" / "NIST_MTC_CRADA_PLATE-13.NC")
+    assert main(["estimate", plate, "--machine", str(machine), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["cycle_time_s"] > data["motion_time_s"] > 0
+    assert data["counts"] == {"tool_changes": 7, "spindle_starts": 7, "optional_stops": 0,
+                              "spindle_runs": 7}  # fmt: skip
+    b = data["breakdown"]
+    assert b["tool_changes"] == 7 * 9.5 and b["program_start_end"] == 4.5
+    # S750, S3750 and five times S9000
+    assert b["spindle_starts"] == pytest.approx(7 * 1.0 + 0.3 * (0.75 + 3.75 + 5 * 9.0))
+    assert sum(b.values()) == pytest.approx(data["cycle_time_s"])
+    assert data["rapid_override_pct"] == data["feed_override_pct"] == 100.0
+    # the generic profile has no [control.sequence]: the blocks alone, as before
+    assert main(["estimate", plate, "--json"]) == 0
+    blocks = json.loads(capsys.readouterr().out)
+    assert blocks["cycle_time_s"] == pytest.approx(data["cycle_time_s"] - 66.5 - b["spindle_starts"]
+                                                   - 4.5)  # fmt: skip
+    assert blocks["breakdown"]["tool_changes"] == 0.0
+
+
+def test_estimate_text_has_motion_time_and_breakdown(program, capsys):
+    assert main(["estimate", str(program), "--feed-override", "50"]) == 0
+    out = capsys.readouterr().out
+    assert "motion time  none (no spindle start)" in out
+    assert "overrides    rapid 100 %, feed 50 %" in out
+    assert "breakdown" in out and "feed_lines" in out and "program_start_end" in out
+
+
+def test_feed_override_doubles_the_cutting_time(program, capsys):
+    # 5 mm rapid at 200 mm/s + 35 mm at 10 mm/s, the 35 mm at half the feed
+    args = ["estimate", str(program), "--json", "--machine", "linuxcnc_sim", "--method", "cam"]
+    assert main([*args, "--feed-override", "50", "--rapid-override", "50"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["cycle_time_s"] == pytest.approx(5 / 100 + 7.0)
+    assert data["motion_time_s"] is None
+
+
+@pytest.mark.parametrize("option", ["--rapid-override", "--feed-override"])
+@pytest.mark.parametrize("value", ["0", "-10", "201", "nan", "fast"])
+def test_overrides_out_of_range_give_one_line(program, capsys, option, value):
+    assert main(["estimate", str(program), option, value]) == 2
+    assert _one_line_error(capsys).startswith(
+        f"nctwin: argument {option}: {value} is out of range: allowed (0, 200] %"
+    )

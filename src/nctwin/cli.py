@@ -1,7 +1,9 @@
 """The ``nctwin`` command line: ``estimate``, ``simulate``, ``machines`` and ``calibrate``.
 
 ``nctwin estimate PROGRAM`` prints the cycle time of a part program (by default with the machine
-profile's ``default_method``); ``nctwin simulate PROGRAM`` interpolates it on the FIR kernel
+profile's ``default_method``), with the non-motion times of the profile's ``[control.sequence]``,
+the motion time between spindle starts and stops, a breakdown and the panel's overrides
+(:mod:`nctwin.estimate.cycle`); ``nctwin simulate PROGRAM`` interpolates it on the FIR kernel
 (the profile's ``[control.fir]``) and can write the feed plot and the sampled motion; ``nctwin
 machines`` lists the shipped machine profiles; ``nctwin calibrate`` fits a profile's control to
 its recordings, or a real machine to its MTConnect logs (:mod:`nctwin.calibrate`), and writes it
@@ -27,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .estimate import METHODS, estimate
+from .estimate import METHODS, cycle_time
+from .estimate.cycle import OVERRIDE_MAX_PCT
 from .gcode import READERS, GCodeError, read
 from .kernel import fir
 from .machine import DEFAULT_MACHINE, Machine, Profile, available_machines, load_profile
@@ -74,9 +77,16 @@ bilstm and axis_nn exist for linuxcnc_sim only; they never predict a move faster
 length over its feed within the machine's limits (the physical floor), and say how many
 moves they raised to it.
 
+The cycle time is program start to end: the method's motion plus, where the profile has a
+[control.sequence] table, its tool changes (M6), spindle starts (M3/M4 at the S in force),
+optional stops (M1 outside a tool change) and program start and end. The motion time runs,
+for each spindle start, from the first move after it to the M5 (or M6, M2, M30) that stops
+it, summed; none where the program starts no spindle. The breakdown splits the cycle time.
+
 examples:
   nctwin estimate part.nc
   nctwin estimate part.nc --method kernel --json
+  nctwin estimate part.nc --machine hurco.toml --feed-override 50 --rapid-override 25
   nctwin estimate part.nc --machine linuxcnc_sim --method bilstm
   nctwin estimate part.nc --machine own_machine.toml
   nctwin estimate part.ngc --reader linuxcnc       subroutines, #parameters, G41/G42
@@ -179,6 +189,15 @@ def _parser() -> argparse.ArgumentParser:
         help="estimator (default: the machine profile's default_method; each needs its control "
         "table in the profile; bilstm and axis_nn need a profile with recordings: linuxcnc_sim)",
     )
+    for name, what in (("rapid", "the machine's rapid feed"), ("feed", "the programmed feeds")):
+        e.add_argument(
+            f"--{name}-override",
+            type=_percent,
+            default=100.0,
+            metavar="PCT",
+            help=f"{name} override: scales {what}, in (0, {OVERRIDE_MAX_PCT:g}] %% (default: "
+            "100; the machine's limits still hold)",
+        )
     e.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
     m = sub.add_parser(
@@ -240,6 +259,19 @@ def _parser() -> argparse.ArgumentParser:
         help="profile file to write (its name, without .toml, names the machine for logs)",
     )
     return p
+
+
+def _percent(text: str) -> float:
+    """An override of the command line (%), in (0, :data:`OVERRIDE_MAX_PCT`]."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 < value <= OVERRIDE_MAX_PCT:
+        raise argparse.ArgumentTypeError(
+            f"{text} is out of range: allowed (0, {OVERRIDE_MAX_PCT:g}] %"
+        )
+    return value
 
 
 def _program_args(p: argparse.ArgumentParser) -> None:
@@ -393,18 +425,34 @@ def _estimate(args: argparse.Namespace, enabled: bool) -> int:
         profile.control_for(method)  # a profile without the method's control: one line
         learned = method in ("bilstm", "axis_nn")
         stage(f"estimate: {method}" + (" (trains on first use)" if learned else ""))
-        result = estimate(tp, profile, method)
+        ct = cycle_time(tp, profile, method, rapid_override_pct=args.rapid_override,
+                        feed_override_pct=args.feed_override)  # fmt: skip
     finally:
         stage.close()
+    result = ct.estimate
     summary = {"program": _program_name(args), "reader": reader, **result.summary()}
+    summary.update(ct.summary(), rapid_override_pct=args.rapid_override,
+                   feed_override_pct=args.feed_override)  # fmt: skip
     rows = _common_rows(summary)
     rows.insert(3, ("method", result.method))
+    motion = ct.motion_time_s
+    rows.insert(5, ("motion time", "none (no spindle start)" if motion is None else
+                    f"{motion:.3f} s  ({_format_duration(motion)})"))  # fmt: skip
+    if (args.rapid_override, args.feed_override) != (100.0, 100.0):
+        rows.insert(6, ("overrides", f"rapid {args.rapid_override:g} %, feed "
+                                     f"{args.feed_override:g} %"))  # fmt: skip
     if result.floor_time_s is not None:
         rows.insert(5, ("floor", f"{result.floor_time_s:.3f} s  (every move at its feed)"))
     table = [f"\n  {'kind':<8} {'blocks':>8} {'length_mm':>12} {'time_s':>10}"] + [
         f"  {kind:<8} {r['blocks']:>8d} {r['length_mm']:>12.3f} {r['time_s']:>10.3f}"
         for kind, r in summary["by_kind"].items()
         if r["blocks"]
+    ]
+    n = ct.counts
+    table.append(f"\n  {'breakdown':<18} {'time_s':>10}")
+    table += [
+        f"  {key:<18} {t:>10.3f}" + (f"  ({n[key]})" if key in n else "")
+        for key, t in ct.breakdown.items()
     ]
     if result.clamped_moves:
         n = result.clamped_moves

@@ -12,7 +12,7 @@ kind          type                    used by
 ``accdec``    :class:`AccDecControl`  :mod:`nctwin.kernel.accdec`, ``--method block_overlap``
 ``fanuc``     :class:`FanucControl`   :mod:`nctwin.kernel.fanuc`
 ``planner``   :class:`PlannerControl` ``--method planner`` and the learned methods
-``sequence``  :class:`SequenceControl`  non-motion times (:mod:`nctwin.calibrate`)
+``sequence``  :class:`SequenceControl`  :mod:`nctwin.estimate.cycle`, :mod:`nctwin.calibrate`
 ============  ======================  ===================================================
 
 Each type owns its period, its time constants, its servo and in-position settings and its

@@ -8,6 +8,10 @@ its controls (:data:`nctwin.machine.METHOD_CONTROLS` says which): ``cam`` on the
 real controller" (:mod:`nctwin.estimate.learned`); they exist only for a profile that names
 shipped recordings (``linuxcnc_sim``), and train once on first use. :func:`estimate` picks the
 control from the profile; a profile that lacks it is refused in one line.
+
+:func:`cycle_time` adds what the shop floor sees (:mod:`nctwin.estimate.cycle`): the times that
+are no motion from the profile's ``[control.sequence]``, the motion time between spindle starts
+and stops, and the feed and rapid overrides.
 """
 
 from __future__ import annotations
@@ -21,14 +25,17 @@ from ..toolpath import Toolpath
 from .blend_planner import blend_planner
 from .block_overlap import block_overlap
 from .cam import cam
+from .cycle import CycleTime, apply_overrides
 from .kernel import kernel
 from .result import Estimate
 
 __all__ = [
     "METHODS",
+    "CycleTime",
     "Estimate",
     "best_method",
     "cam",
+    "cycle_time",
     "estimate",
     "kernel",
 ]
@@ -92,6 +99,32 @@ def estimate(toolpath: Toolpath, profile: Profile, method: str | None = None) ->
         raise ValueError(f"method = {method!r} is unknown: allowed {', '.join(METHODS)}") from None
     profile.control_for(method)  # refuses a profile without the method's control first
     return fn(toolpath, profile)
+
+
+def cycle_time(
+    toolpath: Toolpath,
+    profile: Profile,
+    method: str | None = None,
+    *,
+    rapid_override_pct: float = 100.0,
+    feed_override_pct: float = 100.0,
+) -> CycleTime:
+    """The cycle time of ``toolpath`` on ``profile``: :func:`estimate` under the overrides
+    (:func:`~nctwin.estimate.cycle.apply_overrides`, 100 % leaves the inputs as they are), plus
+    the non-motion times of the profile's ``[control.sequence]`` (none without it).
+
+    Raises
+    ------
+    ValueError
+        As :func:`estimate`, and for an override out of (0, 200] %.
+    """
+    toolpath, profile = apply_overrides(
+        toolpath,
+        profile,
+        rapid_override_pct=rapid_override_pct,
+        feed_override_pct=feed_override_pct,
+    )
+    return CycleTime.of(estimate(toolpath, profile, method), profile.sequence)
 
 
 def best_method(summary: pd.DataFrame) -> str:
