@@ -36,6 +36,7 @@ __all__ = [
     "FIR_GRID",
     "PLANNER_FIT_START",
     "PlannerFit",
+    "at_rapid_override",
     "calibrate_fir",
     "fir_fields",
     "fir_fit_programs",
@@ -78,6 +79,28 @@ def identified_block_overlap(tp: Toolpath, machine: Machine, period_s: float) ->
     )
 
 
+def at_rapid_override(machine: Machine, share: float) -> Machine:
+    """``machine`` at a rapid override of ``share`` (1: 100 %): its rapid feed and its axis
+    velocities scaled by it (the accelerations and the maximum feed kept)."""
+    if share == 1.0:
+        return machine
+    return dataclasses.replace(
+        machine,
+        axis_max_velocity_mm_s=tuple(float(v) * share for v in machine.axis_max_velocity_mm_s),
+        rapid_feed_mm_s=machine.rapid_feed_mm_s * share,
+    )
+
+
+def _overrides(rapid_overrides: Sequence[float] | None, n: int) -> np.ndarray:
+    """The rapid overrides (shares) of ``n`` programs, checked; all 1 where None."""
+    scales = np.ones(n) if rapid_overrides is None else np.asarray(rapid_overrides, float)
+    if scales.shape != (n,) or not ((scales > 0) & (scales <= 1)).all():
+        raise ValueError(
+            f"rapid_overrides {scales.tolist()[:3]}: allowed one per program, in (0, 1]"
+        )
+    return scales
+
+
 #: Names of the :class:`~nctwin.controls.FirControl` settings that :func:`fit_fir` fits, as
 #: its grid and trials name them.
 FIR_FIELDS = ("fir_t1_s", "fir_t2_s", "fir_acc_scale", "fir_blend_ratio", "fir_block_periods")
@@ -93,10 +116,14 @@ FIT_EVERY = 5
 
 
 def _fir_trial(
-    programs: Sequence[tuple[Toolpath, float]], machine: Machine, control: FirControl
+    programs: Sequence[tuple[Toolpath, float]],
+    machine: Machine,
+    control: FirControl,
+    scales: np.ndarray,
 ) -> dict:
     measured = np.array([m for _, m in programs])
-    sim = np.array([kernel(tp, machine, control).cycle_time_s for tp, _ in programs])
+    sim = np.array([kernel(tp, at_rapid_override(machine, k), control).cycle_time_s
+                    for (tp, _), k in zip(programs, scales, strict=True)])  # fmt: skip
     err = error_pct(sim, measured)
     return {
         "score": float(np.abs(np.log(sim / measured)).mean()),
@@ -112,6 +139,7 @@ def fit_fir(
     grid: dict[str, Sequence[float]],
     *,
     n_jobs: int = 2,
+    rapid_overrides: Sequence[float] | None = None,
 ) -> tuple[FirControl, list[dict]]:
     """Fit the FIR kernel's settings to recorded cycle times by a grid search.
 
@@ -135,6 +163,9 @@ def fit_fir(
         Values to try for each field of :data:`FIR_FIELDS`.
     n_jobs : int
         Workers of :func:`nctwin.runner.run_tasks` (one grid point each).
+    rapid_overrides : sequence of float, optional
+        Per program, the rapid override it ran at as a share (1: 100 %, the default;
+        :func:`at_rapid_override`).
 
     Returns
     -------
@@ -147,7 +178,8 @@ def fit_fir(
         raise ValueError(f"grid has keys {sorted(grid)}: allowed exactly {list(FIR_FIELDS)}")
     values = itertools.product(*(grid[n] for n in FIR_FIELDS))
     points = [dict(zip(FIR_FIELDS, v, strict=True)) for v in values]
-    tasks = ((programs, machine, _fir_control(base, p)) for p in points)
+    scales = _overrides(rapid_overrides, len(programs))
+    tasks = ((programs, machine, _fir_control(base, p), scales) for p in points)
     scores = run_tasks(_fir_trial, tasks, n_jobs=n_jobs)
     trials = [p | r for p, r in zip(points, scores, strict=True)]
     return _fir_control(base, min(trials, key=lambda r: r["score"])), trials
@@ -324,11 +356,7 @@ def fit_planner(
     measured = np.array([t for _, t in programs], dtype=float)
     if not (measured > 0).all():
         raise ValueError(f"measured cycle times {measured[measured <= 0][:3]} s: allowed > 0")
-    scales = np.ones(len(programs)) if rapid_overrides is None else np.asarray(rapid_overrides)
-    if scales.shape != (len(programs),) or not ((scales > 0) & (scales <= 1)).all():
-        raise ValueError(
-            f"rapid_overrides {scales.tolist()[:3]}: allowed one per program, in (0, 1]"
-        )
+    scales = _overrides(rapid_overrides, len(programs))
     n = 6 if fit_velocities else 3
     lower = np.log([10.0] * 3 + [1.0] * 3)[:n]
     upper = np.log([1e5] * 3 + [machine.max_feed_mm_s] * 3)[:n]
@@ -348,18 +376,10 @@ def fit_planner(
             axis_max_velocity_mm_s=tuple(float(v) for v in velocity),
         )
 
-    def at_override(m: Machine, scale: float) -> Machine:
-        if scale == 1.0:
-            return m
-        return dataclasses.replace(
-            m,
-            axis_max_velocity_mm_s=tuple(float(v) * scale for v in m.axis_max_velocity_mm_s),
-            rapid_feed_mm_s=m.rapid_feed_mm_s * scale,
-        )
-
     def planned_s(m: Machine, stop_periods: str) -> np.ndarray:
         return np.array(
-            [blend_planner(tp, at_override(m, k), control, stop_periods=stop_periods).cycle_time_s
+            [blend_planner(tp, at_rapid_override(m, k), control,
+                           stop_periods=stop_periods).cycle_time_s
              for (tp, _), k in zip(programs, scales, strict=True)]
         )  # fmt: skip
 
