@@ -7,14 +7,17 @@ from __future__ import annotations
 from datetime import date
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from nctwin.calibrate import (
     RunTimes,
+    axis_rapid_mm_s,
     calibrate,
     leave_one_program_out,
     machine_runs,
     program_lines,
+    run_overrides,
     span_s,
     write_profile,
 )
@@ -84,8 +87,9 @@ def _runs(lines, cut_s: float, n: int = 3) -> list[RunTimes]:
         tc = 12.0 + d
         spindle = 2.0 + lines.spindle_rpm / 1000.0 + d
         motion = cut_s + tc + spindle.sum() + 0.5
-        out.append(RunTimes(f"run{k}", lines.file, 500.0, motion, 4.0 + d, 1.0 + d,
-                            np.array([np.nan, tc]), spindle, np.array([0.5 + d])))  # fmt: skip
+        out.append(RunTimes(f"run{k}", lines.file, 500.0, np.nan, motion, motion + 5.0 + 2 * d,
+                            4.0 + d, 1.0 + d, np.array([np.nan, tc]), spindle,
+                            np.array([0.5 + d])))  # fmt: skip
     return out
 
 
@@ -111,6 +115,33 @@ def _machine500() -> Machine:
     return Machine("hand", "", (500.0,) * 3, (1000.0,) * 3, (np.inf,) * 3, 500.0, 500.0)
 
 
+def _run(plateau_mm_s: float, override_pct: float) -> RunTimes:
+    empty = np.zeros(0)
+    return RunTimes("log", "P.NC", plateau_mm_s, override_pct, 100.0, 110.0, 4.0, 1.0, empty,
+                    empty, empty)  # fmt: skip
+
+
+def test_the_rapid_override_of_a_run_by_hand():
+    # the axis rapid from the plateaus at a logged override: 169.335 / 50 % and 254 / 75 % are
+    # 338.67 mm/s, and the median ignores a rapid that never reached its plateau (15 / 65 %)
+    rapids = pd.DataFrame({"plateau_mm_s": [169.335, 254.0025, 15.0],
+                           "rapid_override_pct": [50.0, 75.0, 65.0]})  # fmt: skip
+    rapid_mm_s, how = axis_rapid_mm_s(rapids, [])
+    assert rapid_mm_s == pytest.approx(338.67) and how.startswith("3 plateaus at a logged")
+    times = [_run(176.1, np.nan), _run(np.nan, 57.0), _run(212.67, np.nan), _run(np.nan, np.nan),
+             _run(338.0, np.nan), _run(340.5, np.nan)]  # fmt: skip
+    pct, source = run_overrides(times, rapid_mm_s)
+    # 176.1 / 338.67 = 52.0 %, 212.67 / 338.67 = 62.8 %: whole per cent; at most 100 %; the
+    # run that shows neither gets the median of the others'
+    assert pct.tolist() == [52.0, 57.0, 63.0, 63.0, 100.0, 100.0]
+    assert source.tolist() == ["plateau", "logged", "plateau", "assumed", "plateau", "plateau"]
+    # no override logged anywhere: the plateaus are taken at 100 %
+    assert axis_rapid_mm_s(None, [_run(500.0, np.nan), _run(np.nan, np.nan)])[0] == 500.0
+    with pytest.raises(ValueError, match="no run shows a rapid plateau"):
+        axis_rapid_mm_s(None, [_run(np.nan, np.nan)])
+    assert run_overrides([_run(np.nan, np.nan)], 500.0)[0].tolist() == [100.0]
+
+
 def test_sequence_control_is_validated():
     with pytest.raises(ValueError, match="tool_change_s = -1"):
         SequenceControl(tool_change_s=-1.0)
@@ -134,12 +165,16 @@ def test_write_profile_reads_back(hand_program, tmp_path):
 
 @pytest.mark.slow
 def test_hurco02_rapid_and_determinism():
-    times, programs = machine_runs("Hurco02")
+    times, programs, rapids = machine_runs("Hurco02")
     assert len(times) == 26
     op3 = [r for r in times if "OP3" in r.program]
-    a = calibrate("Hurco02", op3, programs)
-    b = calibrate("Hurco02", op3, programs)
+    a = calibrate("Hurco02", op3, programs, rapids)
+    b = calibrate("Hurco02", op3, programs, rapids)
     assert a.machine.rapid_feed_mm_s == pytest.approx(500.0, abs=1.0)
+    # the planner's axis velocities are the rapid plateau the logs show, not fitted
+    plateau = np.nanmedian([r.rapid_plateau_mm_s for r in times])
+    np.testing.assert_allclose(a.planner_machine.axis_max_velocity_mm_s, plateau, rtol=0.01)
+    assert (a.override_source != "assumed").sum() == 11 and set(a.overrides_pct) == {100.0}
     assert a.sequence == b.sequence
     assert a.fir == b.fir and a.planner_machine == b.planner_machine
     assert 10.0 < a.sequence.tool_change_s < 20.0
@@ -147,13 +182,12 @@ def test_hurco02_rapid_and_determinism():
 
 @pytest.mark.slow
 def test_leave_one_program_out_table():
-    times, programs = machine_runs("Hurco04")
-    # three plates whose runs show a rapid plateau (PLATE-12 and 13 show none: without them,
-    # no fold is left without a rapid feed)
-    keep = sorted({r.program for r in times if np.isfinite(r.rapid_mm_s)})[:3]
+    times, programs, rapids = machine_runs("Hurco04")
+    # three plates whose runs show a rapid plateau (their rapid override known, so fitted)
+    keep = sorted({r.program for r in times if np.isfinite(r.rapid_plateau_mm_s)})[:3]
     times = [r for r in times if r.program in keep]
-    table = leave_one_program_out("Hurco04", times, programs)
-    assert table.shape == (9, 7)
+    table = leave_one_program_out("Hurco04", times, programs, rapids)
+    assert table.shape == (9, 11)
     assert sorted(set(table["program"])) == keep
     assert table.groupby("program")["chosen"].sum().tolist() == [1, 1, 1]
 

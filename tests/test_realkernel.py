@@ -209,6 +209,39 @@ def test_fit_planner_recovers_the_limits_that_made_the_times():
     assert list(fit.limits.profile) == [1000, 1000, 500, 200, 200, 100]
 
 
+def test_fit_planner_with_fixed_velocities_recovers_the_accelerations():
+    # the velocities known (a real machine's rapid plateaus), only the accelerations are fitted;
+    # two programs run at a 50 % rapid override: their axis velocities and rapid feed halve
+    truth = dataclasses.replace(MACHINE, axis_max_acceleration_mm_s2=(800.0, 1200.0, 300.0))
+    texts = [
+        "G21 G90 G61\nG1 X5 F6000\nG1 X10\nG1 X0 Y0\n",
+        "G21 G90 G61\nG1 Y5 F6000\nG1 Y10\nG1 X3 Y0\n",
+        "G21 G90 G61\nG1 Z2 F6000\nG1 Z4\nG1 Z0\n",
+        "G21 G90\nG0 X200\nG0 Y0\n",
+        "G21 G90\nG0 Z50\nG0 Z0\n",
+    ]
+    overrides = [1.0, 1.0, 1.0, 0.5, 0.5]
+    programs = []
+    for text, k in zip(texts, overrides, strict=True):
+        tp = parse(text, start_mm=(0, 0, 0))
+        run_on = dataclasses.replace(
+            truth,
+            axis_max_velocity_mm_s=tuple(v * k for v in truth.axis_max_velocity_mm_s),
+            rapid_feed_mm_s=truth.rapid_feed_mm_s * k,
+        )
+        programs.append((tp, blend_planner(tp, run_on, PLANNER).cycle_time_s))
+    fit = identify.fit_planner(
+        programs, MACHINE, PLANNER, fit_velocities=False, rapid_overrides=overrides
+    )
+    np.testing.assert_allclose(fit.machine.axis_max_acceleration_mm_s2, (800, 1200, 300), rtol=5e-3)
+    assert fit.machine.axis_max_velocity_mm_s == MACHINE.axis_max_velocity_mm_s
+    velocity = fit.limits[fit.limits.limit == "velocity_mm_s"]
+    assert list(velocity.start) == list(velocity.fitted) == list(MACHINE.axis_max_velocity_mm_s)
+    assert fit.max_err_pct < 0.5
+    with pytest.raises(ValueError, match="allowed one per program, in"):
+        identify.fit_planner(programs, MACHINE, PLANNER, rapid_overrides=[1.0, 57.0])
+
+
 def test_fit_planner_rejects_bad_input():
     tp = parse("G21 G90\nG1 X10 F600\n", start_mm=(0, 0, 0))
     with pytest.raises(ValueError, match="programs is empty"):

@@ -2,6 +2,16 @@ r"""Calibrate one real machine from its MTConnect logs (:mod:`nctwin.mtconnect`)
 feed, the times that are no motion (tool changes, spindle starts, optional stops, the start and
 the end of a run), and the control model that times its motion best.
 
+**The rapid feed** is read, not fitted: each axis's rapid is the plateau of the steady
+``Feed_Rate`` on single-axis G0 lines (:func:`nctwin.mtconnect.steady_feed`) divided by the
+``Rapid_Override`` then in force, over every run of the logs (valid or not) where that override is
+logged (:func:`axis_rapid_mm_s`); the planner's three axis velocities are that rapid, and only
+their accelerations are fitted. The rapid override a run ran at (:func:`run_overrides`) is the
+logged one, else its plateau over the axis rapid (whole per cent, at most 100), else, where the
+run shows neither, the median of the others' (``assumed``: such runs are predicted but not
+fitted); every prediction of a run runs its rapids at it
+(:func:`nctwin.identify.at_rapid_override`).
+
 The logs time a program's lines, not its motion: ``Block_Number`` names the line executing
 from then on, logged on change, so a short line may never show and a line's event may lag its
 start. The times are therefore read as spans between events (:func:`span_s`: from the first
@@ -23,8 +33,8 @@ identified rapid feed (what a motion estimator adds back when it times the same 
   the run's end (PROGRAM_COMPLETED).
 
 :func:`calibrate` fits them and the motion models on some runs, :func:`predict_runs` predicts
-``Verdict.motion_s`` of others, :func:`leave_one_program_out` does both with each program held
-out, :func:`write_profile` writes the machine's profile file.
+``Verdict.motion_s`` and the duration of others, :func:`leave_one_program_out` does both with
+each program held out, :func:`write_profile` writes the machine's profile file.
 """
 
 from __future__ import annotations
@@ -42,9 +52,9 @@ from .controls import FirControl, PlannerControl, SequenceControl
 from .estimate import cam, kernel
 from .estimate.blend_planner import blend_planner
 from .gcode import parse_file
-from .identify import fit_fir, fit_planner
+from .identify import at_rapid_override, fit_fir, fit_planner
 from .machine import Machine, write_control
-from .mtconnect import Run, read_log, runs, validate
+from .mtconnect import Run, Verdict, parse_program, read_log, runs, steady_feed, validate
 from .paths import nist_dir
 from .toolpath import Toolpath
 
@@ -55,11 +65,13 @@ __all__ = [
     "Calibration",
     "ProgramLines",
     "RunTimes",
+    "axis_rapid_mm_s",
     "calibrate",
     "leave_one_program_out",
     "machine_runs",
     "predict_runs",
     "program_lines",
+    "run_overrides",
     "run_times",
     "span_s",
     "write_profile",
@@ -161,10 +173,11 @@ class RunTimes:
     Parameters
     ----------
     log, program : str
-    rapid_mm_s : float
-        ``Verdict.rapid_plateau_mm_s`` divided by the logged rapid override (NaN: no plateau).
-    motion_s : float
-        ``Verdict.motion_s``.
+    rapid_plateau_mm_s, rapid_override_pct : float
+        ``Verdict.rapid_plateau_mm_s`` (NaN: no plateau) and ``Verdict.rapid_override_pct``
+        (logged, in force from the first cut on; NaN: not logged).
+    motion_s, duration_s : float
+        ``Verdict.motion_s``; the run's start to its end (:attr:`Run.duration_s`).
     program_start_s, program_end_s : float
         Start to the first block event; the M30 line's event to the end.
     tool_change_s, spindle_start_s, optional_stop_s : numpy.ndarray
@@ -174,8 +187,10 @@ class RunTimes:
 
     log: str
     program: str
-    rapid_mm_s: float
+    rapid_plateau_mm_s: float
+    rapid_override_pct: float
     motion_s: float
+    duration_s: float
     program_start_s: float
     program_end_s: float
     tool_change_s: np.ndarray
@@ -183,16 +198,16 @@ class RunTimes:
     optional_stop_s: np.ndarray
 
 
-def run_times(run: Run, lines: ProgramLines, rapid_plateau_mm_s: float, motion_s: float):
-    """The :class:`RunTimes` of ``run`` on the program ``lines``."""
+def run_times(run: Run, lines: ProgramLines, verdict: Verdict) -> RunTimes:
+    """The :class:`RunTimes` of the valid ``run`` on the program ``lines``."""
     t, b = run.block_t_s, run.block
-    ro = run.rapid_override_pct.initial
-    ro = 100.0 if np.isnan(ro) else ro
     return RunTimes(
         run.log,
         lines.file,
-        rapid_plateau_mm_s * 100.0 / ro,
-        motion_s,
+        verdict.rapid_plateau_mm_s,
+        verdict.rapid_override_pct,
+        verdict.motion_s,
+        run.duration_s,
         float(t[0] - run.start_s),
         float(run.end_s - t[-1]),
         np.array([span_s(t, b, a, z) for a, z in lines.tool_changes]),
@@ -205,16 +220,20 @@ def machine_runs(
     machine_name: str,
     log_paths: Sequence[str | Path] | None = None,
     programs_dir: str | Path | None = None,
-) -> tuple[list[RunTimes], dict[str, tuple[ProgramLines, Toolpath]]]:
+) -> tuple[list[RunTimes], dict[str, tuple[ProgramLines, Toolpath]], pd.DataFrame]:
     """The valid runs of one machine in the logs (default: the shipped ones whose name holds
     ``machine_name``) against the programs of ``programs_dir`` (``*.NC``; default the shipped
-    ones, :func:`nctwin.paths.nist_dir`).
+    ones, :func:`nctwin.paths.nist_dir`), and the rapid plateaus of all its runs.
 
     Returns
     -------
     runs : list of RunTimes
     programs : dict of str to (ProgramLines, Toolpath)
         The programs the runs ran, by file name.
+    rapids : pandas.DataFrame
+        A row per run of a known program (valid or not) and logged rapid override it reaches a
+        plateau at: ``log``, ``program``, ``rapid_override_pct``, ``plateau_mm_s`` (the highest
+        steady feed on a single-axis G0 line while that override is in force).
 
     Raises
     ------
@@ -227,24 +246,75 @@ def machine_runs(
     texts = {p.name: p.read_text() for p in sorted(nc.glob("*.NC"))}
     if log_paths is None:
         log_paths = sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz"))
-    out, programs, why = [], {}, []
+    out, programs, why, rapids = [], {}, [], []
     for path in map(Path, log_paths):
         for run in runs(read_log(path)):
             v = validate(run, texts)
+            if v.program is not None:
+                rapids += _plateaus(run, parse_program(v.program, texts[v.program]))
             if not v.valid:
                 why.append(f"{path.name}: {v.reason} ({v.detail})")
                 continue
             if v.program not in programs:
                 programs[v.program] = program_lines(nc / v.program)
-            out.append(run_times(run, programs[v.program][0], v.rapid_plateau_mm_s, v.motion_s))
+            out.append(run_times(run, programs[v.program][0], v))
     if not out:
         first = f"; {why[0]}" if why else ""
         raise ValueError(f"no valid run of {machine_name} in {len(log_paths)} log(s){first}")
-    return out, programs
+    columns = ["log", "program", "rapid_override_pct", "plateau_mm_s"]
+    return out, programs, pd.DataFrame(rapids, columns=columns)
+
+
+def _plateaus(run: Run, program) -> list[tuple]:
+    """(log, program, override, plateau) per logged rapid override > 0 that ``run`` reaches a
+    single-axis G0 plateau at (:func:`machine_runs`)."""
+    t, line, v = steady_feed(run, program)
+    rapid = program.single_axis_rapid[line]
+    pct = run.rapid_override_pct.at(t[rapid])
+    return [(run.log, program.file, float(o), float(v[rapid][pct == o].max()))
+            for o in np.unique(pct[np.isfinite(pct) & (pct > 0)])]  # fmt: skip
+
+
+def axis_rapid_mm_s(rapids: pd.DataFrame | None, times: Sequence[RunTimes]) -> tuple[float, str]:
+    """Each axis's rapid at 100 % (mm/s) and how it was read: the median of ``rapids``'
+    plateaus over their logged overrides (:func:`machine_runs`), else (no override logged) the
+    median plateau of ``times``, taken at 100 % (also where ``rapids`` is None).
+
+    Raises
+    ------
+    ValueError
+        Neither shows a plateau.
+    """
+    if rapids is not None and len(rapids):
+        ratio = rapids["plateau_mm_s"] * 100.0 / rapids["rapid_override_pct"]
+        return float(ratio.median()), f"{len(rapids)} plateaus at a logged rapid override"
+    plateau = np.array([r.rapid_plateau_mm_s for r in times])
+    if not np.isfinite(plateau).any():
+        raise ValueError("no run shows a rapid plateau: the rapid feed is unknown")
+    n = np.isfinite(plateau).sum()
+    return float(np.nanmedian(plateau)), f"{n} plateaus, no override logged: taken at 100 %"
+
+
+def run_overrides(
+    times: Sequence[RunTimes], rapid_mm_s: float, assumed_pct: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rapid override (%) each run ran at and where it comes from (``logged``; ``plateau``:
+    its plateau over ``rapid_mm_s``, in whole per cent, at most 100; ``assumed``:
+    ``assumed_pct``, where None the median of the others', 100 where none is known)."""
+    logged = np.array([r.rapid_override_pct for r in times])
+    seen = np.array([r.rapid_plateau_mm_s for r in times]) * 100.0 / rapid_mm_s
+    pct = np.where(np.isfinite(logged), logged, np.minimum(np.round(seen), 100.0))
+    source = np.where(np.isfinite(logged), "logged", np.where(np.isfinite(seen), "plateau", ""))
+    known = np.isfinite(pct)
+    if assumed_pct is None:
+        assumed_pct = np.median(pct[known]) if known.any() else 100.0
+    pct[~known] = assumed_pct
+    return pct, np.where(known, source, "assumed")
 
 
 def _machine(name: str, rapid_mm_s: float) -> Machine:
-    """A machine of the identified rapid feed (every axis at it) and a generic acceleration."""
+    """A machine of the identified axis rapid (every axis and the rapid feed at it) and a
+    generic acceleration."""
     return Machine(
         name=name,
         description=f"{name}, calibrated from its MTConnect logs (nctwin.calibrate)",
@@ -273,10 +343,11 @@ class Calibration:
     Parameters
     ----------
     machine : Machine
-        Every axis and the rapid at the identified rapid feed.
-    rapid_mm_s : numpy.ndarray
-        Shape (n,): each calibration run's rapid plateau / its logged rapid override (NaN: no
-        plateau); ``machine.rapid_feed_mm_s`` is their median.
+        Every axis and the rapid at the axis rapid (:func:`axis_rapid_mm_s`), at 100 %.
+    rapid_source : str
+        How the axis rapid was read.
+    overrides_pct, override_source : numpy.ndarray
+        Shape (n,): each calibration run's rapid override and its source (:func:`run_overrides`).
     sequence : SequenceControl
         The non-motion times.
     residuals_s : dict of str to numpy.ndarray
@@ -286,7 +357,8 @@ class Calibration:
         The fitted controls (the planner's axis limits are in ``planner_machine``).
     planner_machine : Machine
     fit_err_pct : dict of str to float
-        Per method, the mean absolute error (%) of the motion time on the calibration runs.
+        Per method, the mean absolute error (%) of the motion time on the calibration runs of a
+        known rapid override (grouped by program and override).
     best : str
         The method of the least ``fit_err_pct``.
     runs : tuple of str
@@ -294,7 +366,9 @@ class Calibration:
     """
 
     machine: Machine
-    rapid_mm_s: np.ndarray
+    rapid_source: str
+    overrides_pct: np.ndarray
+    override_source: np.ndarray
     sequence: SequenceControl
     residuals_s: dict
     planner: PlannerControl
@@ -305,45 +379,55 @@ class Calibration:
     runs: tuple
 
 
-def _sequence_s(lines: ProgramLines, seq: SequenceControl) -> float:
-    """The non-motion time ``seq`` gives the motion window of a program (s)."""
-    after = lines.spindle_starts[:, 0] >= lines.first_cut
-    tc = lines.tool_changes[:, 0] >= lines.first_cut
+def _sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
+    """The non-motion time ``seq`` gives the motion window of a program (s), or (``window``
+    False) its lines before the window, where the first approach ends."""
+    after = (lines.spindle_starts[:, 0] >= lines.first_cut) == window
+    tc = (lines.tool_changes[:, 0] >= lines.first_cut) == window
     spindle = sum(seq.spindle_s(rpm) for rpm in lines.spindle_rpm[after])
-    stops = lines.optional_stops.size * seq.optional_stop_s
-    return float(tc.sum() * seq.tool_change_s + spindle + stops)
+    stops = (lines.optional_stops >= lines.first_cut) == window
+    return float(tc.sum() * seq.tool_change_s + spindle + stops.sum() * seq.optional_stop_s)
 
 
-def _motion_s(method: str, tp: Toolpath, machine: Machine, cal: Calibration) -> float:
-    """The motion time (s) of ``tp`` by ``method`` with ``cal``'s fitted controls."""
+def _motion_s(method: str, tp: Toolpath, cal: Calibration, pct: float) -> float:
+    """The motion time (s) of ``tp`` by ``method`` with ``cal``'s fitted controls, its rapids at
+    a rapid override of ``pct`` (%)."""
     if method == "cam":
-        return cam(tp, machine).cycle_time_s
+        return cam(tp, at_rapid_override(cal.machine, pct / 100)).cycle_time_s
     if method == "planner":
-        return blend_planner(tp, cal.planner_machine, cal.planner).cycle_time_s
-    return kernel(tp, machine, cal.fir).cycle_time_s
+        machine = at_rapid_override(cal.planner_machine, pct / 100)
+        return blend_planner(tp, machine, cal.planner).cycle_time_s
+    return kernel(tp, at_rapid_override(cal.machine, pct / 100), cal.fir).cycle_time_s
 
 
 def calibrate(
-    name: str, times: Sequence[RunTimes], programs: dict, *, n_jobs: int = 2
+    name: str,
+    times: Sequence[RunTimes],
+    programs: dict,
+    rapids: pd.DataFrame | None = None,
+    *,
+    n_jobs: int = 2,
 ) -> Calibration:
     """Identify the rapid feed, the non-motion times and the motion models from ``times``.
 
-    Non-motion times are medians of the net spans (the module docstring), the spindle start a
-    least-squares line in the commanded speed where the runs command two speeds or more. The
-    planner's axis limits are fitted by :func:`nctwin.identify.fit_planner`, the FIR kernel by
-    :func:`nctwin.identify.fit_fir` on :data:`CALIBRATE_FIR_GRID`, each on the median motion
-    time (minus the non-motion times) of each program; the best method is the one of least
-    mean absolute error on these same runs.
+    The axis rapid is :func:`axis_rapid_mm_s` of ``rapids`` (:func:`machine_runs`; None: no
+    override logged), each run's rapid override :func:`run_overrides`. Non-motion times are
+    medians of the net spans (the module docstring), the spindle start a least-squares line in
+    the commanded speed where the runs command two speeds or more. The planner's three axis
+    accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
+    axis rapid), the FIR kernel by :func:`nctwin.identify.fit_fir` on
+    :data:`CALIBRATE_FIR_GRID`, each on the median motion time (minus the non-motion times) of
+    each program and rapid override, runs of an assumed override left out; the best method is
+    the one of least mean absolute error on these same runs.
     """
-    rapid = np.array([r.rapid_mm_s for r in times])
-    if not np.isfinite(rapid).any():
-        raise ValueError(f"no run of {name} shows a rapid plateau: the rapid feed is unknown")
-    machine = _machine(name, float(np.nanmedian(rapid)))
+    rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
+    pct, source = run_overrides(times, rapid_mm_s)
+    machine = _machine(name, rapid_mm_s)
     net: dict[str, list] = {"tool_change": [], "spindle_start": [], "optional_stop": []}
     rpm: list[float] = []
-    for r in times:
+    for r, o in zip(times, pct, strict=True):
         lines, tp = programs[r.program]
-        blocks = cam(tp, machine).block_times_s
+        blocks = cam(tp, at_rapid_override(machine, o / 100)).block_times_s
         for key, spans, gross in (
             ("tool_change", lines.tool_changes, r.tool_change_s),
             ("spindle_start", lines.spindle_starts, r.spindle_start_s),
@@ -380,72 +464,112 @@ def calibrate(
         program_end_s=fitted["program_end"],
     )
     logs = tuple(r.log for r in times)
-    pairs = []
-    for file in sorted({r.program for r in times}):
+    pairs, shares = [], []
+    groups = {(r.program, o) for r, o, s in zip(times, pct, source, strict=True) if s != "assumed"}
+    if not groups:
+        raise ValueError(f"no run of {name} has a known rapid override: no motion to fit")
+    for file, o in sorted(groups):
         lines, tp = programs[file]
-        measured = np.median([r.motion_s for r in times if r.program == file])
+        measured = np.median([r.motion_s for r, k in zip(times, pct, strict=True)
+                              if r.program == file and k == o])  # fmt: skip
         pairs.append((tp.take(_window(tp, lines)), measured - _sequence_s(lines, seq)))
+        shares.append(o / 100)
     planner = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
-    pfit = fit_planner(pairs, machine, planner)
+    pfit = fit_planner(pairs, machine, planner, fit_velocities=False, rapid_overrides=shares)
     fir, _ = fit_fir(pairs, machine, FirControl(period_s=0.002, blend_tol_mm=0.0254),
-                     CALIBRATE_FIR_GRID, n_jobs=n_jobs)  # fmt: skip
-    cal = Calibration(machine, rapid, seq, residuals, planner, pfit.machine, fir, {}, "cam",
-                      logs)  # fmt: skip
+                     CALIBRATE_FIR_GRID, n_jobs=n_jobs, rapid_overrides=shares)  # fmt: skip
+    cal = Calibration(machine, rapid_source, pct, source, seq, residuals, planner,
+                      pfit.machine, fir, {}, "cam", logs)  # fmt: skip
     err = {}
     for method in METHODS:
-        sim = np.array([_motion_s(method, tp, machine, cal) for tp, _ in pairs])
+        sim = np.array([_motion_s(method, tp, cal, 100 * k)
+                        for (tp, _), k in zip(pairs, shares, strict=True)])  # fmt: skip
         target = np.array([t for _, t in pairs])
         err[method] = float(np.mean(np.abs(sim / target - 1)) * 100)
     best = min(err, key=err.get)
-    return Calibration(machine, rapid, seq, residuals, planner, pfit.machine, fir, err, best,
-                       logs)  # fmt: skip
+    return Calibration(machine, rapid_source, pct, source, seq, residuals, planner,
+                       pfit.machine, fir, err, best, logs)  # fmt: skip
 
 
 def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) -> pd.DataFrame:
-    """Predicted ``motion_s`` of each run by each of :data:`METHODS` (motion plus
-    ``cal.sequence``): a row per run and method, ``log``, ``program``, ``method``,
-    ``measured_s``, ``predicted_s``, ``error_pct``."""
+    """Predicted ``motion_s`` and duration of each run by each of :data:`METHODS`, its rapids at
+    its rapid override (:func:`run_overrides` with ``cal``'s axis rapid; where assumed, the
+    median of ``cal``'s runs of a known override).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per run and method: ``log``, ``program``, ``method``, ``override_pct``,
+        ``override_source``, ``measured_s``, ``predicted_s`` (the motion window's motion plus
+        ``cal.sequence``), ``error_pct``, ``measured_cycle_s`` (the run's duration),
+        ``predicted_cycle_s`` (the window, plus the motion and the non-motion times before it,
+        plus the program start and end).
+    """
+    assumed = float(np.median(cal.overrides_pct[cal.override_source != "assumed"]))
+    pct, source = run_overrides(times, cal.machine.rapid_feed_mm_s, assumed)
+    seq = cal.sequence
     rows = []
     cache: dict = {}
-    for r in times:
+    for r, o, s in zip(times, pct, source, strict=True):
         lines, tp = programs[r.program]
         for method in METHODS:
-            key = (r.program, method)
+            key = (r.program, method, o)
             if key not in cache:
-                window = tp.take(_window(tp, lines))
-                cache[key] = _motion_s(method, window, cal.machine, cal) + _sequence_s(
-                    lines, cal.sequence
-                )
+                window = _window(tp, lines)
+                before = tp.line < lines.first_cut
+                motion = _motion_s(method, tp.take(window), cal, o) + _sequence_s(lines, seq)
+                start = _motion_s(method, tp.take(before), cal, o) if before.any() else 0.0
+                start += _sequence_s(lines, seq, window=False)
+                cache[key] = motion, motion + start + seq.program_start_s + seq.program_end_s
+            motion, cycle = cache[key]
             rows.append({"log": r.log, "program": r.program, "method": method,
-                         "measured_s": r.motion_s, "predicted_s": cache[key],
-                         "error_pct": 100 * (cache[key] / r.motion_s - 1)})  # fmt: skip
+                         "override_pct": o, "override_source": s, "measured_s": r.motion_s,
+                         "predicted_s": motion, "error_pct": 100 * (motion / r.motion_s - 1),
+                         "measured_cycle_s": r.duration_s,
+                         "predicted_cycle_s": cycle})  # fmt: skip
     return pd.DataFrame(rows)
 
 
 def leave_one_program_out(
-    name: str, times: Sequence[RunTimes], programs: dict, *, n_jobs: int = 2
+    name: str,
+    times: Sequence[RunTimes],
+    programs: dict,
+    rapids: pd.DataFrame | None = None,
+    *,
+    n_jobs: int = 2,
 ) -> pd.DataFrame:
-    """Each program's runs predicted by a calibration on the other programs' runs.
+    """Each program's runs predicted by a calibration on the other programs' runs (and on the
+    other programs' rows of ``rapids``).
 
     Returns
     -------
     pandas.DataFrame
         A row per held-out program and method: ``program``, ``method``, ``runs``,
-        ``median_measured_s``, ``predicted_s``, ``error_pct`` (signed, against the median of
-        the program's runs), ``chosen`` (the method the calibration picked on its own runs).
+        ``override`` (the runs' rapid overrides and sources, e.g. ``"57 % plateau"``),
+        ``median_measured_s``, ``predicted_s`` (the median over the runs), ``error_pct``
+        (signed, against the median of the program's runs), ``median_cycle_s``,
+        ``predicted_cycle_s``, ``cycle_error_pct`` (the same for the run's duration),
+        ``chosen`` (the method the calibration picked on its own runs).
     """
     rows = []
     for file in sorted({r.program for r in times}):
         train = [r for r in times if r.program != file]
         test = [r for r in times if r.program == file]
-        cal = calibrate(name, train, programs, n_jobs=n_jobs)
+        other = None if rapids is None else rapids[rapids["program"] != file]
+        cal = calibrate(name, train, programs, other, n_jobs=n_jobs)
         pred = predict_runs(cal, test, programs)
         for method, g in pred.groupby("method", sort=False):
             measured = float(g["measured_s"].median())
-            predicted = float(g["predicted_s"].iloc[0])
+            predicted = float(g["predicted_s"].median())
+            cycle = float(g["measured_cycle_s"].median())
+            predicted_cycle = float(g["predicted_cycle_s"].median())
+            used = zip(g["override_pct"], g["override_source"], strict=True)
+            override = sorted({f"{o:g} % {s}" for o, s in used})
             rows.append({"program": file, "method": method, "runs": len(g),
-                         "median_measured_s": measured, "predicted_s": predicted,
-                         "error_pct": 100 * (predicted / measured - 1),
+                         "override": ", ".join(override), "median_measured_s": measured,
+                         "predicted_s": predicted, "error_pct": 100 * (predicted / measured - 1),
+                         "median_cycle_s": cycle, "predicted_cycle_s": predicted_cycle,
+                         "cycle_error_pct": 100 * (predicted_cycle / cycle - 1),
                          "chosen": method == cal.best})  # fmt: skip
     return pd.DataFrame(rows)
 
@@ -467,8 +591,8 @@ def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
     out = Path(output)
     out.write_text(
         f"# {m.name}, calibrated from {len(cal.runs)} valid runs of its MTConnect logs\n"
-        f"# (nctwin.calibrate): rapid feed the median rapid plateau over "
-        f"{np.isfinite(cal.rapid_mm_s).sum()} runs.\n"
+        f"# (nctwin.calibrate): axis velocities and rapid feed the median single-axis rapid\n"
+        f"# plateau over its rapid override ({cal.rapid_source}).\n"
         f'default_method = "{cal.best}"\n\n[machine]\n'
         f'name = "{m.name}"\ndescription = "{m.description}"\n'
         f"axis_max_velocity_mm_s = {_vec(m.axis_max_velocity_mm_s)}\n"
@@ -481,14 +605,17 @@ def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
     if cal.best != "cam":
         kind = "planner" if cal.best == "planner" else "fir"
         control = cal.planner if kind == "planner" else cal.fir
+        what = ("The axis accelerations (the velocities: the rapid plateau)" if kind == "planner"
+                else "The FIR kernel's settings")  # fmt: skip
         write_control(out, kind, control, [
-            f"Fitted by nctwin.calibrate on the motion times of {runs_text}.",
+            f"{what} fitted by nctwin.calibrate on the", f"motion times of {runs_text}.",
             f"Mean absolute motion-time error on them: {fit}."], today=today)  # fmt: skip
     res = cal.residuals_s
     write_control(out, "sequence", cal.sequence, [
-        f"Non-motion times from the block events of {runs_text} (nctwin.calibrate).",
-        f"Residuals: tool change {_residual_text(res['tool_change'])}; spindle start "
-        f"{_residual_text(res['spindle_start'])};",
-        f"program start {_residual_text(res['program_start'])}; program end "
-        f"{_residual_text(res['program_end'])}; optional stop "
+        "Non-motion times (nctwin.calibrate) from the block events of",
+        f"{runs_text}.",
+        f"Residuals: tool change {_residual_text(res['tool_change'])};",
+        f"spindle start {_residual_text(res['spindle_start'])};",
+        f"program start {_residual_text(res['program_start'])};",
+        f"program end {_residual_text(res['program_end'])}; optional stop "
         f"{_residual_text(res['optional_stop'])}."], today=today)  # fmt: skip

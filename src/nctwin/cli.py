@@ -605,8 +605,8 @@ def _calibrate_logs(args: argparse.Namespace) -> int:
     if args.programs is not None and not Path(args.programs).is_dir():
         raise ValueError(f"--programs {args.programs}: no such folder")
     name = Path(args.output).stem
-    times, programs = machine_runs(name, args.logs, args.programs)
-    cal = calibrate(name, times, programs)
+    times, programs, rapids = machine_runs(name, args.logs, args.programs)
+    cal = calibrate(name, times, programs, rapids)
     write_profile(cal, args.output, today=date.today())
     seq = cal.sequence
     print(f"{name}: {len(times)} valid runs of {len(programs)} programs")

@@ -6,8 +6,8 @@ so that a model of it times programs as the control does.
 * :func:`fit_fir`: the FIR kernel's settings (:class:`~nctwin.controls.FirControl`) by a
   grid search on recorded cycle times; :func:`calibrate_fir` fits them to a profile's shipped
   recordings and writes them into the profile's file (``nctwin calibrate``);
-* :func:`fit_planner`: the blend-arc planner's six axis limits by least squares on recorded
-  cycle times.
+* :func:`fit_planner`: the blend-arc planner's six axis limits (or its three accelerations,
+  the velocities known) by least squares on recorded cycle times.
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ __all__ = [
     "FIR_GRID",
     "PLANNER_FIT_START",
     "PlannerFit",
+    "at_rapid_override",
     "calibrate_fir",
     "fir_fields",
     "fir_fit_programs",
@@ -78,6 +79,28 @@ def identified_block_overlap(tp: Toolpath, machine: Machine, period_s: float) ->
     )
 
 
+def at_rapid_override(machine: Machine, share: float) -> Machine:
+    """``machine`` at a rapid override of ``share`` (1: 100 %): its rapid feed and its axis
+    velocities scaled by it (the accelerations and the maximum feed kept)."""
+    if share == 1.0:
+        return machine
+    return dataclasses.replace(
+        machine,
+        axis_max_velocity_mm_s=tuple(float(v) * share for v in machine.axis_max_velocity_mm_s),
+        rapid_feed_mm_s=machine.rapid_feed_mm_s * share,
+    )
+
+
+def _overrides(rapid_overrides: Sequence[float] | None, n: int) -> np.ndarray:
+    """The rapid overrides (shares) of ``n`` programs, checked; all 1 where None."""
+    scales = np.ones(n) if rapid_overrides is None else np.asarray(rapid_overrides, float)
+    if scales.shape != (n,) or not ((scales > 0) & (scales <= 1)).all():
+        raise ValueError(
+            f"rapid_overrides {scales.tolist()[:3]}: allowed one per program, in (0, 1]"
+        )
+    return scales
+
+
 #: Names of the :class:`~nctwin.controls.FirControl` settings that :func:`fit_fir` fits, as
 #: its grid and trials name them.
 FIR_FIELDS = ("fir_t1_s", "fir_t2_s", "fir_acc_scale", "fir_blend_ratio", "fir_block_periods")
@@ -93,10 +116,14 @@ FIT_EVERY = 5
 
 
 def _fir_trial(
-    programs: Sequence[tuple[Toolpath, float]], machine: Machine, control: FirControl
+    programs: Sequence[tuple[Toolpath, float]],
+    machine: Machine,
+    control: FirControl,
+    scales: np.ndarray,
 ) -> dict:
     measured = np.array([m for _, m in programs])
-    sim = np.array([kernel(tp, machine, control).cycle_time_s for tp, _ in programs])
+    sim = np.array([kernel(tp, at_rapid_override(machine, k), control).cycle_time_s
+                    for (tp, _), k in zip(programs, scales, strict=True)])  # fmt: skip
     err = error_pct(sim, measured)
     return {
         "score": float(np.abs(np.log(sim / measured)).mean()),
@@ -112,6 +139,7 @@ def fit_fir(
     grid: dict[str, Sequence[float]],
     *,
     n_jobs: int = 2,
+    rapid_overrides: Sequence[float] | None = None,
 ) -> tuple[FirControl, list[dict]]:
     """Fit the FIR kernel's settings to recorded cycle times by a grid search.
 
@@ -135,6 +163,9 @@ def fit_fir(
         Values to try for each field of :data:`FIR_FIELDS`.
     n_jobs : int
         Workers of :func:`nctwin.runner.run_tasks` (one grid point each).
+    rapid_overrides : sequence of float, optional
+        Per program, the rapid override it ran at as a share (1: 100 %, the default;
+        :func:`at_rapid_override`).
 
     Returns
     -------
@@ -147,7 +178,8 @@ def fit_fir(
         raise ValueError(f"grid has keys {sorted(grid)}: allowed exactly {list(FIR_FIELDS)}")
     values = itertools.product(*(grid[n] for n in FIR_FIELDS))
     points = [dict(zip(FIR_FIELDS, v, strict=True)) for v in values]
-    tasks = ((programs, machine, _fir_control(base, p)) for p in points)
+    scales = _overrides(rapid_overrides, len(programs))
+    tasks = ((programs, machine, _fir_control(base, p), scales) for p in points)
     scores = run_tasks(_fir_trial, tasks, n_jobs=n_jobs)
     trials = [p | r for p, r in zip(points, scores, strict=True)]
     return _fir_control(base, min(trials, key=lambda r: r["score"])), trials
@@ -246,7 +278,8 @@ class PlannerFit:
         The machine with the identified axis limits.
     limits : DataFrame
         One row per axis and limit: ``axis``, ``limit`` (``acceleration_mm_s2`` or
-        ``velocity_mm_s``), ``start``, ``fitted``, ``profile`` (the value the profile had).
+        ``velocity_mm_s``), ``start``, ``fitted``, ``profile`` (the value the profile had; a
+        velocity held fixed starts, and stays, at it).
     mean_err_pct, max_err_pct : float
         Mean and largest absolute cycle-time error (%) of the fitted planner on the programs.
     evaluations : int
@@ -265,6 +298,9 @@ def fit_planner(
     machine: Machine,
     control: PlannerControl,
     start: tuple[float, float] = PLANNER_FIT_START,
+    *,
+    fit_velocities: bool = True,
+    rapid_overrides: Sequence[float] | None = None,
 ) -> PlannerFit:
     r"""Identify the blend-arc planner's axis limits from recorded cycle times.
 
@@ -282,6 +318,12 @@ def fit_planner(
     recording can tell it. Everything else (the machine's maximum and rapid feed, the control's
     servo period and default tolerance) is kept.
 
+    With ``fit_velocities=False`` only the three accelerations are fitted and the velocities are
+    ``machine``'s: a real machine's axis velocities show in its logs (the rapid plateaus,
+    :mod:`nctwin.calibrate`), and a least-squares fit of a few cycle times trades them against
+    the accelerations. ``rapid_overrides`` gives each program the rapid override it ran at:
+    its planner runs with the rapid feed and the axis velocities scaled by it.
+
     Parameters
     ----------
     programs : sequence of (Toolpath, float)
@@ -291,7 +333,12 @@ def fit_planner(
     control : PlannerControl
         The planner's period and default tolerance.
     start : (float, float)
-        Acceleration (mm/s^2) and velocity (mm/s) every axis starts from.
+        Acceleration (mm/s^2) and velocity (mm/s) every axis starts from (the velocity unused
+        with ``fit_velocities=False``).
+    fit_velocities : bool
+        Fit the three axis velocities too (the default), else keep ``machine``'s.
+    rapid_overrides : sequence of float, optional
+        Per program, the rapid override in force as a share (1: 100 %, the default).
 
     Returns
     -------
@@ -300,17 +347,20 @@ def fit_planner(
     Raises
     ------
     ValueError
-        If there are no programs, a recorded time is not positive, or ``start`` lies outside
-        the bounds (acceleration 10 to 1e5 mm/s^2, velocity 1 mm/s to the maximum feed).
+        If there are no programs, a recorded time is not positive, ``start`` lies outside
+        the bounds (acceleration 10 to 1e5 mm/s^2, velocity 1 mm/s to the maximum feed), or a
+        rapid override is not in (0, 1] or not one per program.
     """
     if not programs:
         raise ValueError("programs is empty: the planner's limits need at least one recording")
     measured = np.array([t for _, t in programs], dtype=float)
     if not (measured > 0).all():
         raise ValueError(f"measured cycle times {measured[measured <= 0][:3]} s: allowed > 0")
-    lower = np.log([10.0] * 3 + [1.0] * 3)
-    upper = np.log([1e5] * 3 + [machine.max_feed_mm_s] * 3)
-    x0 = np.log([start[0]] * 3 + [start[1]] * 3)
+    scales = _overrides(rapid_overrides, len(programs))
+    n = 6 if fit_velocities else 3
+    lower = np.log([10.0] * 3 + [1.0] * 3)[:n]
+    upper = np.log([1e5] * 3 + [machine.max_feed_mm_s] * 3)[:n]
+    x0 = np.log([start[0]] * 3 + [start[1]] * 3)[:n]
     if not ((x0 >= lower) & (x0 <= upper)).all():
         raise ValueError(
             f"start = {start!r} is out of range: allowed acceleration [10, 1e5] mm/s^2, "
@@ -319,16 +369,18 @@ def fit_planner(
 
     def profile(x: np.ndarray) -> Machine:
         e = np.exp(x)
+        velocity = e[3:] if fit_velocities else machine.axis_max_velocity_mm_s
         return dataclasses.replace(
             machine,
             axis_max_acceleration_mm_s2=tuple(float(v) for v in e[:3]),
-            axis_max_velocity_mm_s=tuple(float(v) for v in e[3:]),
+            axis_max_velocity_mm_s=tuple(float(v) for v in velocity),
         )
 
     def planned_s(m: Machine, stop_periods: str) -> np.ndarray:
         return np.array(
-            [blend_planner(tp, m, control, stop_periods=stop_periods).cycle_time_s
-             for tp, _ in programs]
+            [blend_planner(tp, at_rapid_override(m, k), control,
+                           stop_periods=stop_periods).cycle_time_s
+             for (tp, _), k in zip(programs, scales, strict=True)]
         )  # fmt: skip
 
     def residual(x: np.ndarray) -> np.ndarray:
@@ -338,10 +390,13 @@ def fit_planner(
     fitted = profile(fit.x)
     err = 100 * np.abs(planned_s(fitted, "whole") / measured - 1)
     limits = pd.DataFrame(
-        [{"axis": axis, "limit": limit, "start": s, "fitted": getattr(fitted, field)[i],
+        [{"axis": axis, "limit": limit, "start": s[i], "fitted": getattr(fitted, field)[i],
           "profile": getattr(machine, field)[i]}
-         for limit, field, s in (("acceleration_mm_s2", "axis_max_acceleration_mm_s2", start[0]),
-                                 ("velocity_mm_s", "axis_max_velocity_mm_s", start[1]))
+         for limit, field, s in (("acceleration_mm_s2", "axis_max_acceleration_mm_s2",
+                                  (start[0],) * 3),
+                                 ("velocity_mm_s", "axis_max_velocity_mm_s",
+                                  (start[1],) * 3 if fit_velocities
+                                  else machine.axis_max_velocity_mm_s))
          for i, axis in enumerate("XYZ")]
     )  # fmt: skip
     return PlannerFit(fitted, limits, float(err.mean()), float(err.max()), int(fit.nfev))

@@ -75,7 +75,7 @@ from .paths import nist_dir
 
 __all__ = ["PAUSE_S", "REASONS", "FeedCheck", "Program", "Run", "Track", "Verdict",
            "feed_check", "nist_runs_table", "parse_program", "read_log", "runs", "runs_table",
-           "validate"]  # fmt: skip
+           "steady_feed", "validate"]  # fmt: skip
 
 #: A line that may carry the rest of the record before it (see the module docstring).
 _FRAGMENT = re.compile(r"[0-9][0-9.]*")
@@ -400,7 +400,7 @@ FEED_SCALE_TOL = 0.005
 SPINDLE_TOL = 0.03
 
 
-def _steady(run: Run, program: Program) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def steady_feed(run: Run, program: Program) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(time, program line, feed) of the run's steady ``Feed_Rate`` samples: in the same block
     as the sample before and within 0.5 % of it, > 0; line 0 where past the program's end."""
     f = run.feed_mm_s
@@ -435,7 +435,7 @@ class FeedCheck:
 
 def feed_check(run: Run, program: Program) -> FeedCheck:
     """The run's logged feed against ``program``'s (:class:`FeedCheck`)."""
-    t, line, v = _steady(run, program)
+    t, line, v = steady_feed(run, program)
     override = run.feed_override_pct.at(t)
     override = np.where(np.isnan(override), 100.0, override)
     planned = program.feed_mm_s[line] * override / 100.0
@@ -625,7 +625,7 @@ def validate(run: Run, programs: dict[str, str]) -> Verdict:
             )
         if cut.size:
             motion_s = float(run.block_t_s[-1] - run.block_t_s[cut[0]])
-        _, line, v = _steady(run, program)
+        _, line, v = steady_feed(run, program)
         rapid = v[program.single_axis_rapid[line]]
         rapid_mm_s = float(rapid.max()) if rapid.size else np.nan
     reasons = tuple(r for r in REASONS if r in found)
