@@ -79,16 +79,17 @@ def test_span_s_runs_between_events():
 
 
 def _runs(lines, cut_s: float, n: int = 3) -> list[RunTimes]:
-    """Runs of the hand program: tool change 12 s, spindle starts 2 + 1 s/krpm, optional stop
-    0.5 s, program start 4 s, end 1 s, each +-0.1 s around it; motion ``cut_s`` + those."""
+    """Runs of the hand program: first tool change 3 s, the other 12 s, spindle starts 2 + 1
+    s/krpm, optional stop 0.5 s, program start 4 s, end 1 s, each +-0.1 s around it; motion
+    ``cut_s`` + those."""
     out = []
     for k in range(n):
         d = 0.1 * (k - 1)
         tc = 12.0 + d
         spindle = 2.0 + lines.spindle_rpm / 1000.0 + d
         motion = cut_s + tc + spindle.sum() + 0.5
-        out.append(RunTimes(f"run{k}", lines.file, 500.0, np.nan, motion, motion + 5.0 + 2 * d,
-                            4.0 + d, 1.0 + d, np.array([np.nan, tc]), spindle,
+        out.append(RunTimes(f"run{k}", lines.file, 500.0, np.nan, motion, motion + 8.0 + 3 * d,
+                            4.0 + d, 1.0 + d, np.array([3.0 + d, tc]), spindle,
                             np.array([0.5 + d])))  # fmt: skip
     return out
 
@@ -102,6 +103,7 @@ def test_calibrate_recovers_the_hand_made_times(hand_program):
     assert cal.machine.rapid_feed_mm_s == 500.0
     # the tool change's G28 line moves Z from 0 to the reference at Z 0: no motion to remove
     assert seq.tool_change_s == pytest.approx(12.0)
+    assert seq.first_tool_change_s == pytest.approx(3.0)  # T1 M6, before any spindle start
     assert seq.spindle_start_s == pytest.approx(2.0)
     assert seq.spindle_start_s_per_krpm == pytest.approx(1.0)
     assert seq.optional_stop_s == pytest.approx(0.5)

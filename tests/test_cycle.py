@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -81,6 +82,16 @@ def test_two_tools_by_hand():
     # tool 1: the X10 rapid to its M5, the M1 between included; tool 2: Y10 and the dwell
     run1 = 0.1 + 1.0 + 0.5 + 3.0 + ARC_S
     assert ct.motion_time_s == pytest.approx(run1 + 2.0 + 1.0)
+
+
+def test_the_first_tool_change_before_any_spindle_start():
+    seq = dataclasses.replace(SEQUENCE, first_tool_change_s=3.0)
+    b = cycle_time(parse(PROGRAM), dataclasses.replace(PROFILE, sequence=seq), "cam").breakdown
+    assert b["tool_changes"] == 3.0 + 8.0  # T1 at rest, T2 after the first spindle run
+    # a tool change before a spindle start that follows an earlier run is no first one
+    tp = parse("G21\nS900 M3\nG1 X10 F600\nM5\nT2 M6\nS900 M3\nG1 X0\n")
+    profile = dataclasses.replace(PROFILE, sequence=seq)
+    assert cycle_time(tp, profile, "cam").breakdown["tool_changes"] == 8.0
 
 
 def test_without_a_sequence_the_cycle_time_is_the_estimates():
@@ -169,7 +180,7 @@ def _reference(items, seq: SequenceControl):
         if word == "S":
             rpm = value
         elif value == 6.0:
-            clock += seq.tool_change_s
+            clock += seq.tool_change_s if any_run else seq.tool_change_at_s(first=True)
         elif value in (3.0, 4.0):
             clock += seq.spindle_s(rpm)
         elif value == 1.0:
@@ -189,7 +200,7 @@ def _reference(items, seq: SequenceControl):
     st.floats(0.0, 5.0),
 )
 def test_random_event_layouts_match_a_walk_through_them(items, spindle_per_krpm):
-    seq = SequenceControl(1.5, -0.5, spindle_per_krpm, 0.7, 0.3, 0.2)
+    seq = SequenceControl(1.5, -0.5, spindle_per_krpm, 0.7, 0.3, 0.2, first_tool_change_s=0.4)
     dwells = [i for i in items if isinstance(i, float)]
     events, n = [], 0
     for line, item in enumerate(items, 1):

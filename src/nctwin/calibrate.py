@@ -23,6 +23,9 @@ identified rapid feed (what a motion estimator adds back when it times the same 
   before a ``Tn M6`` line to the ``M6`` line, both included; the ``M01`` between them on every
   shipped program is in it (optional stop off: a valid run has no pause), and so is the Z
   travel to the real home above the program's ``G28`` point.
+* **First tool change** (:attr:`SequenceControl.first_tool_change_s`): the ``Tn M6`` line
+  before the program's first spindle start, where the spindle is at rest and no return comes
+  before it (on the shipped runs 3-6 s against about 14 s for the others).
 * **Spindle start**: from the ``S.. M3`` line to the line after it, both included: the control
   moves on only once the spindle is at speed. A constant where the calibration runs command
   one speed, a line in the speed where they command several
@@ -351,8 +354,8 @@ class Calibration:
     sequence : SequenceControl
         The non-motion times.
     residuals_s : dict of str to numpy.ndarray
-        Measured minus fitted, per non-motion time (``tool_change``, ``spindle_start``,
-        ``optional_stop``, ``program_start``, ``program_end``).
+        Measured minus fitted, per non-motion time (``tool_change``, ``first_tool_change``,
+        ``spindle_start``, ``optional_stop``, ``program_start``, ``program_end``).
     planner, fir : PlannerControl, FirControl
         The fitted controls (the planner's axis limits are in ``planner_machine``).
     planner_machine : Machine
@@ -379,14 +382,23 @@ class Calibration:
     runs: tuple
 
 
+def _first_changes(lines: ProgramLines) -> np.ndarray:
+    """Mask of ``lines.tool_changes`` before the first spindle start (shape (k,))."""
+    first = lines.spindle_starts[0, 0] if len(lines.spindle_starts) else np.inf
+    return lines.tool_changes[:, 1] < first
+
+
 def _sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
     """The non-motion time ``seq`` gives the motion window of a program (s), or (``window``
     False) its lines before the window, where the first approach ends."""
     after = (lines.spindle_starts[:, 0] >= lines.first_cut) == window
     tc = (lines.tool_changes[:, 0] >= lines.first_cut) == window
+    first = _first_changes(lines)
     spindle = sum(seq.spindle_s(rpm) for rpm in lines.spindle_rpm[after])
     stops = (lines.optional_stops >= lines.first_cut) == window
-    return float(tc.sum() * seq.tool_change_s + spindle + stops.sum() * seq.optional_stop_s)
+    changes = (tc & first).sum() * seq.tool_change_at_s(True)
+    changes += (tc & ~first).sum() * seq.tool_change_s
+    return float(changes + spindle + stops.sum() * seq.optional_stop_s)
 
 
 def _motion_s(method: str, tp: Toolpath, cal: Calibration, pct: float) -> float:
@@ -423,7 +435,8 @@ def calibrate(
     rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
     pct, source = run_overrides(times, rapid_mm_s)
     machine = _machine(name, rapid_mm_s)
-    net: dict[str, list] = {"tool_change": [], "spindle_start": [], "optional_stop": []}
+    net: dict[str, list] = {"tool_change": [], "first_tool_change": [], "spindle_start": [],
+                            "optional_stop": []}  # fmt: skip
     rpm: list[float] = []
     for r, o in zip(times, pct, strict=True):
         lines, tp = programs[r.program]
@@ -436,6 +449,8 @@ def calibrate(
             inside = spans[:, 0] >= lines.first_cut  # the window's: the others are the start's
             motion = np.array([blocks[m].sum() for m in _span_blocks(tp, spans[inside])])
             net[key] += list(gross[inside] - motion)
+        first = _first_changes(lines)
+        net["first_tool_change"] += list(r.tool_change_s[first])  # no motion on an M6 line
         rpm += list(lines.spindle_rpm[lines.spindle_starts[:, 0] >= lines.first_cut])
     rpm_arr = np.asarray(rpm)
     residuals = {}
@@ -447,16 +462,17 @@ def calibrate(
         slope, icpt = 0.0, float(np.nanmedian(med["spindle_start"]))
     residuals["spindle_start"] = med["spindle_start"][ok] - (icpt + slope * rpm_arr[ok] / 1000.0)
     fitted = {}
-    for key in ("tool_change", "optional_stop"):
+    for key in ("tool_change", "first_tool_change", "optional_stop"):
         v = med[key][np.isfinite(med[key])]
-        fitted[key] = float(np.median(v)) if v.size else 0.0
-        residuals[key] = v - fitted[key]
+        fitted[key] = float(np.median(v)) if v.size else (None if key[0] == "f" else 0.0)
+        residuals[key] = v - (fitted[key] or 0.0)
     for key in ("program_start", "program_end"):
         v = np.array([getattr(r, f"{key}_s") for r in times])
         fitted[key] = float(np.median(v))
         residuals[key] = v - fitted[key]
     seq = SequenceControl(
         tool_change_s=fitted["tool_change"],
+        first_tool_change_s=fitted["first_tool_change"],
         spindle_start_s=float(icpt),
         spindle_start_s_per_krpm=float(slope),
         optional_stop_s=fitted["optional_stop"],
@@ -615,6 +631,7 @@ def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
         "Non-motion times (nctwin.calibrate) from the block events of",
         f"{runs_text}.",
         f"Residuals: tool change {_residual_text(res['tool_change'])};",
+        f"first tool change {_residual_text(res['first_tool_change'])};",
         f"spindle start {_residual_text(res['spindle_start'])};",
         f"program start {_residual_text(res['program_start'])};",
         f"program end {_residual_text(res['program_end'])}; optional stop "

@@ -611,7 +611,8 @@ def _calibrate_logs(args: argparse.Namespace) -> int:
     seq = cal.sequence
     print(f"{name}: {len(times)} valid runs of {len(programs)} programs")
     print(f"rapid feed {cal.machine.rapid_feed_mm_s:.2f} mm/s; tool change "
-          f"{seq.tool_change_s:.2f} s; spindle start {seq.spindle_start_s:.2f} s + "
+          f"{seq.tool_change_s:.2f} s (first {seq.tool_change_at_s(True):.2f} s); spindle start "
+          f"{seq.spindle_start_s:.2f} s + "
           f"{seq.spindle_start_s_per_krpm:.3f} s per 1000 rev/min")  # fmt: skip
     errs = ", ".join(f"{k} {v:.2f} %" for k, v in cal.fit_err_pct.items())
     print(f"motion-time error on these runs: {errs}; best {cal.best}; wrote {args.output}")

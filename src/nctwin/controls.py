@@ -366,6 +366,10 @@ class SequenceControl:
         An ``M01`` line outside a tool change, optional stop off, in [0, 600] s.
     program_start_s, program_end_s : float
         Cycle start to the first block; the M30 line to the end of the run; each in [0, 600] s.
+    first_tool_change_s : float or None
+        A tool change before the program's first spindle start (the spindle at rest, no
+        return before it: the ``Tn M6`` a program opens with), in [0, 600] s; None (the key
+        left out): as ``tool_change_s``.
     """
 
     tool_change_s: float = 0.0
@@ -374,13 +378,24 @@ class SequenceControl:
     optional_stop_s: float = 0.0
     program_start_s: float = 0.0
     program_end_s: float = 0.0
+    first_tool_change_s: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("tool_change_s", "optional_stop_s", "program_start_s", "program_end_s"):
             check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
+        if self.first_tool_change_s is not None:
+            check_number("first_tool_change_s", self.first_tool_change_s, 0.0, 600.0,
+                         lo_closed=True, hi_closed=True)  # fmt: skip
         for name in ("spindle_start_s", "spindle_start_s_per_krpm"):
             check_number(name, getattr(self, name), -600.0, 600.0, lo_closed=True,
                          hi_closed=True)  # fmt: skip
+
+    def tool_change_at_s(self, first: bool) -> float:
+        """The time (s) of a tool change, ``first``: before the program's first spindle
+        start."""
+        if first and self.first_tool_change_s is not None:
+            return self.first_tool_change_s
+        return self.tool_change_s
 
     def spindle_s(self, rpm: float) -> float:
         """The time (s) of a spindle start to ``rpm`` rev/min."""

@@ -393,7 +393,8 @@ def write_control(
         after.pop(0)
     table = [f"# {line}" for line in (*provenance, f"Written by nctwin on {today.isoformat()}.")]
     table.append(header)
-    table += [f"{f.name} = {_toml_value(getattr(control, f.name))}" for f in fields(control)]
+    table += [f"{f.name} = {_toml_value(getattr(control, f.name))}" for f in fields(control)
+              if getattr(control, f.name) is not None]  # None: the key left out  # fmt: skip
     text = "\n".join([*before, "", *table, *([""] if after else []), *after]) + "\n"
     tmp = p.with_name(p.name + ".tmp")
     tmp.write_text(text)

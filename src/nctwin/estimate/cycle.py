@@ -9,7 +9,9 @@ involved, as :mod:`nctwin.calibrate` measures them. :class:`CycleTime` adds them
 program's M, S and T words (:attr:`Toolpath.events <nctwin.toolpath.Toolpath.events>`) put
 them:
 
-* **Tool change**: one per ``M6`` word, :attr:`SequenceControl.tool_change_s`.
+* **Tool change**: one per ``M6`` word, :attr:`SequenceControl.tool_change_s`, or
+  :attr:`SequenceControl.first_tool_change_s` before the program's first ``M3``/``M4`` (the
+  spindle at rest, no return before it).
 * **Spindle start**: one per ``M3`` or ``M4`` word, ``SequenceControl.spindle_s(S)`` with the
   S in force (the last S word before it or on its line; 0 rev/min where none was given).
 * **Optional stop**: one per ``M1`` word outside a tool change,
@@ -169,16 +171,16 @@ def _walk(ev: np.ndarray, seq: SequenceControl) -> tuple[np.ndarray, np.ndarray,
         rpm_s = float(value[lo + s[-1]]) if s.size else rpm_s
         rpm[lo:hi] = rpm_s
     event_s, kinds = np.zeros(e), np.full(e, "", dtype="U16")
-    windows, start = [], None
+    windows, start, spun = [], None, False
     for i in range(e):
         if m[i] == 6.0:
-            event_s[i], kinds[i] = seq.tool_change_s, "tool_changes"
+            event_s[i], kinds[i] = seq.tool_change_at_s(first=not spun), "tool_changes"
         elif m[i] in _STARTS:
             event_s[i], kinds[i] = seq.spindle_s(rpm[i]), "spindle_starts"
         elif m[i] == 1.0 and not (start is None and nxt[i] == 6.0):
             event_s[i], kinds[i] = seq.optional_stop_s, "optional_stops"
         if m[i] in _STARTS and start is None:
-            start = int(ev["block"][i])
+            start, spun = int(ev["block"][i]), True
         elif m[i] in _STOPS and start is not None:
             windows.append((start, i))
             start = None
