@@ -148,3 +148,20 @@ def test_estimator_agrees_with_kernel_within_one_period_per_block(items, at_s):
     assert per_block.max() <= TI * (1 + 1e-6)
     assert abs(measured.cycle_time_s - predicted.cycle_time_s) <= len(tp) * TI * (1 + 1e-6)
     assert predicted.cycle_time_s >= measured.cycle_time_s - 1e-9  # rounding up per block
+
+
+def test_fit_block_overlap_recovers_the_time_constant():
+    from nctwin.identify import fit_block_overlap, identified_block_overlap
+
+    programs = []
+    for text in ("G21 G1 X10 F600\nY5\nX0\n", "G21 G1 X3 F1200\nX6 Y1\nX9\nG0 X0 Y0\n"):
+        tp = parse(text)
+        true = dataclasses.replace(identified_block_overlap(tp, MACHINE, TI),
+                                   cut_time_constant_s=0.037)  # fmt: skip
+        programs.append((tp, block_overlap(tp, MACHINE, true).cycle_time_s))
+    fitted = fit_block_overlap(programs, MACHINE, TI)
+    assert fitted.cut_time_constant_s == pytest.approx(0.037)
+    assert (
+        fitted.rapid_time_constant_s
+        == identified_block_overlap(tp, MACHINE, TI).rapid_time_constant_s
+    )

@@ -1,6 +1,7 @@
 r"""Calibrate one real machine from its MTConnect logs (:mod:`nctwin.mtconnect`): the rapid
 feed, the times that are no motion (tool changes, spindle starts, optional stops, the start and
-the end of a run), and the control model that times its motion best.
+the end of a run), and the control model that times its motion best (CAM, Lee et al.'s block
+overlap, the blend-arc planner or the FIR kernel).
 
 **The rapid feed** is read, not fitted: each axis's rapid is the plateau of the steady
 ``Feed_Rate`` on single-axis G0 lines (:func:`nctwin.mtconnect.steady_feed`) divided by the
@@ -42,6 +43,7 @@ each program held out, :func:`write_profile` writes the machine's profile file.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -51,11 +53,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .controls import FirControl, PlannerControl, SequenceControl
-from .estimate import cam, kernel
+from .controls import AccDecControl, FirControl, PlannerControl, SequenceControl
+from .estimate import block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner
 from .gcode import parse_file
-from .identify import at_rapid_override, fit_fir, fit_planner
+from .identify import at_rapid_override, fit_block_overlap, fit_fir, fit_planner
 from .machine import Machine, write_control
 from .mtconnect import Run, Verdict, parse_program, read_log, runs, steady_feed, validate
 from .paths import nist_dir
@@ -64,6 +66,7 @@ from .toolpath import Toolpath
 __all__ = [
     "BASE_ACCELERATION_MM_S2",
     "CALIBRATE_FIR_GRID",
+    "LEE_PERIOD_S",
     "METHODS",
     "Calibration",
     "ProgramLines",
@@ -81,11 +84,13 @@ __all__ = [
 ]
 
 #: The motion estimators compared, by the profile's method names.
-METHODS = ("cam", "planner", "kernel")
+METHODS = ("cam", "block_overlap", "planner", "kernel")
 #: The FIR kernel's grid here: small, as a 30-minute program takes the kernel seconds.
 CALIBRATE_FIR_GRID = {"fir_t1_s": [0.03, 0.09], "fir_t2_s": [0.01],
                       "fir_acc_scale": [0.25, 0.5, 1.0, 2.0], "fir_blend_ratio": [0.25],
                       "fir_block_periods": [0]}  # fmt: skip
+#: The interpolation period of Lee et al.'s estimator here (s; the Hurcos' is not published).
+LEE_PERIOD_S = 0.001
 #: The axis acceleration (mm/s^2) of the machine the FIR kernel scales (its ``acc_scale``).
 BASE_ACCELERATION_MM_S2 = 1000.0
 
@@ -359,6 +364,10 @@ class Calibration:
     planner, fir : PlannerControl, FirControl
         The fitted controls (the planner's axis limits are in ``planner_machine``).
     planner_machine : Machine
+    block_overlap : AccDecControl
+        Lee et al. (2022)'s time constants (:func:`nctwin.identify.fit_block_overlap`; its
+        rapid time constant from ``planner_machine``'s acceleration), run on
+        ``planner_machine``.
     fit_err_pct : dict of str to float
         Per method, the mean absolute error (%) of the motion time on the calibration runs of a
         known rapid override (grouped by program and override).
@@ -376,6 +385,7 @@ class Calibration:
     residuals_s: dict
     planner: PlannerControl
     planner_machine: Machine
+    block_overlap: AccDecControl
     fir: FirControl
     fit_err_pct: dict
     best: str
@@ -409,6 +419,9 @@ def _motion_s(method: str, tp: Toolpath, cal: Calibration, pct: float) -> float:
     if method == "planner":
         machine = at_rapid_override(cal.planner_machine, pct / 100)
         return blend_planner(tp, machine, cal.planner).cycle_time_s
+    if method == "block_overlap":
+        machine = at_rapid_override(cal.planner_machine, pct / 100)
+        return block_overlap(tp, machine, cal.block_overlap).cycle_time_s
     return kernel(tp, at_rapid_override(cal.machine, pct / 100), cal.fir).cycle_time_s
 
 
@@ -427,10 +440,11 @@ def calibrate(
     medians of the net spans (the module docstring), the spindle start a least-squares line in
     the commanded speed where the runs command two speeds or more. The planner's three axis
     accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
-    axis rapid), the FIR kernel by :func:`nctwin.identify.fit_fir` on
-    :data:`CALIBRATE_FIR_GRID`, each on the median motion time (minus the non-motion times) of
-    each program and rapid override, runs of an assumed override left out; the best method is
-    the one of least mean absolute error on these same runs.
+    axis rapid), Lee et al.'s cutting time constant by :func:`nctwin.identify.fit_block_overlap`
+    (period :data:`LEE_PERIOD_S`, on the planner's machine), the FIR kernel by
+    :func:`nctwin.identify.fit_fir` on :data:`CALIBRATE_FIR_GRID`, each on the median motion
+    time (minus the non-motion times) of each program and rapid override, runs of an assumed
+    override left out; the best method is the one of least mean absolute error on these same runs.
     """
     rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
     pct, source = run_overrides(times, rapid_mm_s)
@@ -492,10 +506,11 @@ def calibrate(
         shares.append(o / 100)
     planner = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
     pfit = fit_planner(pairs, machine, planner, fit_velocities=False, rapid_overrides=shares)
+    lee = fit_block_overlap(pairs, pfit.machine, LEE_PERIOD_S, shares)
     fir, _ = fit_fir(pairs, machine, FirControl(period_s=0.002, blend_tol_mm=0.0254),
                      CALIBRATE_FIR_GRID, n_jobs=n_jobs, rapid_overrides=shares)  # fmt: skip
     cal = Calibration(machine, rapid_source, pct, source, seq, residuals, planner,
-                      pfit.machine, fir, {}, "cam", logs)  # fmt: skip
+                      pfit.machine, lee, fir, {}, "cam", logs)  # fmt: skip
     err = {}
     for method in METHODS:
         sim = np.array([_motion_s(method, tp, cal, 100 * k)
@@ -503,8 +518,7 @@ def calibrate(
         target = np.array([t for _, t in pairs])
         err[method] = float(np.mean(np.abs(sim / target - 1)) * 100)
     best = min(err, key=err.get)
-    return Calibration(machine, rapid_source, pct, source, seq, residuals, planner,
-                       pfit.machine, fir, err, best, logs)  # fmt: skip
+    return dataclasses.replace(cal, fit_err_pct=err, best=best)
 
 
 def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) -> pd.DataFrame:
@@ -603,7 +617,7 @@ def _vec(v) -> str:
 def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
     """Write ``cal`` as a profile file: ``[machine]``, ``default_method`` (``cal.best``), the
     best method's control table and ``[control.sequence]``, each with its provenance."""
-    m = cal.machine if cal.best != "planner" else cal.planner_machine
+    m = cal.machine if cal.best in ("cam", "kernel") else cal.planner_machine
     out = Path(output)
     out.write_text(
         f"# {m.name}, calibrated from {len(cal.runs)} valid runs of its MTConnect logs\n"
@@ -619,10 +633,13 @@ def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
     runs_text = f"{len(cal.runs)} runs ({cal.runs[0]} ... {cal.runs[-1]})"
     fit = ", ".join(f"{k} {v:.2f} %" for k, v in cal.fit_err_pct.items())
     if cal.best != "cam":
-        kind = "planner" if cal.best == "planner" else "fir"
-        control = cal.planner if kind == "planner" else cal.fir
-        what = ("The axis accelerations (the velocities: the rapid plateau)" if kind == "planner"
-                else "The FIR kernel's settings")  # fmt: skip
+        kind, control, what = {
+            "planner": ("planner", cal.planner,
+                        "The axis accelerations (the velocities: the rapid plateau)"),
+            "block_overlap": ("accdec", cal.block_overlap,
+                              "The cutting time constant (the rapid one from the planner's fit)"),
+            "kernel": ("fir", cal.fir, "The FIR kernel's settings"),
+        }[cal.best]  # fmt: skip
         write_control(out, kind, control, [
             f"{what} fitted by nctwin.calibrate on the", f"motion times of {runs_text}.",
             f"Mean absolute motion-time error on them: {fit}."], today=today)  # fmt: skip

@@ -6,6 +6,8 @@ so that a model of it times programs as the control does.
 * :func:`fit_fir`: the FIR kernel's settings (:class:`~nctwin.controls.FirControl`) by a
   grid search on recorded cycle times; :func:`calibrate_fir` fits them to a profile's shipped
   recordings and writes them into the profile's file (``nctwin calibrate``);
+* :func:`fit_block_overlap`: Lee et al. (2022)'s cutting time constant by least squares on
+  recorded motion times;
 * :func:`fit_planner`: the blend-arc planner's six axis limits (or its three accelerations,
   the velocities known) by least squares on recorded cycle times.
 """
@@ -25,6 +27,7 @@ from scipy.optimize import least_squares
 
 from .controls import AccDecControl, FirControl, PlannerControl
 from .estimate.blend_planner import blend_planner
+from .estimate.block_overlap import block_overlap
 from .estimate.kernel import kernel
 from .machine import Machine, Profile, profile_path, write_control
 from .report.tables import error_pct
@@ -40,6 +43,7 @@ __all__ = [
     "calibrate_fir",
     "fir_fields",
     "fir_fit_programs",
+    "fit_block_overlap",
     "fit_fir",
     "fit_planner",
     "identified_block_overlap",
@@ -77,6 +81,46 @@ def identified_block_overlap(tp: Toolpath, machine: Machine, period_s: float) ->
         rapid_type="linear",
         inposition_time_s=(0.0, 0.0, 0.0),
     )
+
+
+#: Largest cutting time constant :func:`fit_block_overlap` tries (s).
+BLOCK_OVERLAP_MAX_S = 0.5
+
+
+def fit_block_overlap(
+    programs: Sequence[tuple[Toolpath, float]],
+    machine: Machine,
+    period_s: float,
+    rapid_overrides: Sequence[float] | None = None,
+) -> AccDecControl:
+    r"""Lee et al. (2022)'s time constants identified from recorded motion times.
+
+    The rapid time constant is :func:`identified_block_overlap`'s, :math:`A_{TR} = F_r / a`
+    at 100 % with ``machine``'s X/Y acceleration (a time constant of the control: a rapid
+    override lowers the rapid feed, not :math:`A_{TR}`); the cutting time constant
+    :math:`A_T`, one for every program, is the whole number of periods in
+    (0, :data:`BLOCK_OVERLAP_MAX_S`] (every tenth, then every one near the best of those) of
+    least squared relative error of
+    :func:`nctwin.estimate.block_overlap.block_overlap`'s time against ``programs``' measured
+    ones, each program's rapids at its rapid override (shares, default 1).
+    """
+    scales = _overrides(rapid_overrides, len(programs))
+    base = identified_block_overlap(programs[0][0], machine, period_s)
+    machines = [at_rapid_override(machine, k) for k in scales]
+
+    def best(periods: np.ndarray) -> int:
+        sse = np.zeros(periods.size)
+        for (tp, measured), m in zip(programs, machines, strict=True):
+            for i, n in enumerate(periods):
+                control = dataclasses.replace(base, cut_time_constant_s=float(n * period_s))
+                sse[i] += (block_overlap(tp, m, control).cycle_time_s / measured - 1.0) ** 2
+        return int(periods[np.argmin(sse)])
+
+    # every tenth period, then every period within ten of the best of those
+    n_max = max(round(BLOCK_OVERLAP_MAX_S / period_s), 1)
+    coarse = best(np.arange(1, n_max + 1, 10))
+    n = best(np.arange(max(coarse - 9, 1), min(coarse + 9, n_max) + 1))
+    return dataclasses.replace(base, cut_time_constant_s=n * period_s)
 
 
 def at_rapid_override(machine: Machine, share: float) -> Machine:
