@@ -183,3 +183,11 @@ def test_training_repeats_bit_for_bit(tmp_path, monkeypatch):
     data = folds[0].held_out[0].data
     np.testing.assert_array_equal(again.predict(data.features), model.predict(data.features))
     assert dataclasses.asdict(again.train_config) == dataclasses.asdict(model.train_config)
+    feeds = nl.move_feeds("Hurco02", op1, (0,), n_jobs=1)
+    assert len(feeds) == len(data.features)
+    assert feeds.attrs["log"] in {h.log for h in folds[0].held_out}
+    np.testing.assert_allclose(
+        feeds["bilstm_feed_mm_s"], data.features[:, 1] / nl.bilstm_move_times(model, data)
+    )
+    (shown,) = [h.data for h in folds[0].held_out if h.log == feeds.attrs["log"]]
+    np.testing.assert_array_equal(feeds["logged_feed_mm_s"], shown.targets[:, 0])

@@ -37,7 +37,8 @@ cut at its tool changes (:func:`tool_sections`): each tool's section is a sub-pr
 validation holds out whole sections (``TrainConfig.val_share`` of them, at least one). The
 held-out program's data take part in neither training nor validation (:func:`fold_data`).
 
-**Budget.** See :func:`learned_predictions`.
+**Budget.** Each network trains on at most :data:`MAX_TRAIN_ROWS` moves of its fold's pieces
+(:func:`learned_predictions` says why and what it costs).
 """
 
 from __future__ import annotations
@@ -701,20 +702,25 @@ def learned_predictions(
     """Each program of ``machine_name`` held out and predicted by the BiLSTM and the per-axis
     networks trained on the other programs' runs, once per seed.
 
-    **Budget.** Every fold of both machines, five seeds, trains in about 3 minutes from an empty
-    cache on two cores (two worker processes, :func:`nctwin.runner.run_tasks`). A Hurco04 fold
-    holds about 370,000 moves (six plates of 63,000 moves, arcs in chords, nearly one geometry
-    at other feeds), Hurco02's OP1 35,000: each network therefore sees at most
-    :data:`MAX_TRAIN_ROWS` training moves, whole windows of ``window_lines`` consecutive moves
-    evenly spaced over its training pieces, and :data:`MAX_VAL_ROWS` of its validation pieces
-    (:func:`sample_windows`), the same rows for every seed. The training settings are the
-    LinuxCNC chapter's (:func:`configs`), the epoch cap far above where early stopping ends
-    every one (``converged``). Same seed, same numbers, bit for bit.
+    **Budget.** Every fold of both machines, five seeds, trains in 100-120 s from an empty cache
+    on two cores shared with other work (98 s and 119 s measured, two worker processes,
+    :func:`nctwin.runner.run_tasks`; 20 s from a full cache). A Hurco04 fold's training
+    programs hold 250,000-315,000 moves (four or five plates of 63,000 moves, arcs in chords,
+    one geometry at other feeds), Hurco02's OP1 35,000; a BiLSTM step took about 5 ms per
+    32 windows of 128 moves on one core, so one epoch over all of a Hurco04 fold's moves would
+    take about 0.3 s, and its networks stop after 25-400 epochs.
+    Each network therefore sees at most :data:`MAX_TRAIN_ROWS` training moves, whole windows of
+    ``window_lines`` consecutive moves evenly spaced over its training pieces, and
+    :data:`MAX_VAL_ROWS` of its validation pieces (:func:`sample_windows`), the same rows for
+    every seed. The training settings are the LinuxCNC chapter's (:func:`configs`), the epoch
+    cap far above where early stopping ends every one (``converged``). Same seed, same numbers,
+    bit for bit (two runs from empty caches agree).
 
     Returns
     -------
     pandas.DataFrame
-        A row per held-out run, method and seed: ``program``, ``log``, ``method``
+        A row per held-out run, method and seed: ``program``, ``log``, ``start_s`` (the run's
+        start: a log may hold two runs), ``method``
         (:data:`METHODS`), ``seed``, ``override_pct``, ``override_source``, ``measured_s`` (the
         run's ``motion_s``), ``predicted_motion_s`` (the networks' own time of the motion
         window's moves, no floor: no tool change, spindle start or optional stop time),
@@ -736,7 +742,8 @@ def learned_predictions(
                         cache[run.override_pct] = float(_move_times(method, nets, run.data).sum())
                     predicted = cache[run.override_pct]
                     rows.append({
-                        "program": fold.program, "log": run.log, "method": method,
+                        "program": fold.program, "log": run.log,
+                        "start_s": run.run.start_s, "method": method,
                         "seed": seed, "override_pct": run.override_pct,
                         "override_source": run.override_source, "measured_s": run.measured_s,
                         "predicted_motion_s": predicted,
