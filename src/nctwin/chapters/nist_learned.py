@@ -1,0 +1,801 @@
+r"""The learned cycle-time methods on a real machine: Chien et al. (2023)'s BiLSTM and Sun et
+al. (2022)'s per-axis networks trained on the MTConnect logs of NIST's Hurco VMX 24s
+(:mod:`nctwin.mtconnect`), each program held out in turn within its machine, the folds of
+:func:`nctwin.calibrate.leave_one_program_out`.
+
+**What a log resolves.** ``Block_Number`` is logged on change, so a short line may never show
+and an event may lag the line's start: the log times *spans*, never single lines. Over the
+motion window (:func:`nctwin.calibrate._window`, what ``Verdict.motion_s`` times), the span
+from the event of line :math:`a` to the event of the next observed line :math:`b` times the
+moves of lines :math:`a \ldots b-1` (:func:`block_spans`). Each move of a span gets the span's
+average feed, its moves' length over its time (:func:`span_targets`): Chien's target, with its
+log time ratio :math:`\ln(F_k \tilde t_k / l_k)` as :func:`nctwin.estimate.learned.move_data`
+forms it (:math:`F_k` the feed feature, :math:`\tilde t_k` the move's share of the span's time
+at the span's average feed). A span that holds a line of non-motion time (:func:`non_motion_lines`:
+a tool change, a spindle start, an optional stop, a dwell, an M-code the control waits at) or
+whose time is not positive is left NaN, out of the loss. Sun's per-axis target
+(:func:`axis_targets`) is the ``Feed_Rate`` record nearest in time to the move's interval (the
+span's time laid over its moves in proportion to their length) among the records within the
+move's span, times the move's direction; NaN where the span holds no record (or is left NaN
+above). The moves and features are :func:`~nctwin.estimate.learned.move_data`'s (arcs cut into
+chords by :func:`~nctwin.estimate.learned.model_blocks`) on the fold's machine
+(:func:`nctwin.calibrate._machine` at the fold's axis rapid, its rapids at the run's rapid
+override, :func:`nctwin.identify.at_rapid_override`) with :data:`CONTROL`.
+
+**One** :class:`~nctwin.estimate.learned.MoveData` **per program and rapid override**
+(:func:`program_move_data`): the targets are the median, move by move, of its runs' targets
+(NaN ones left out). The runs of one program at one override run the same text at the same
+features (Hurco02's OP1 and OP3 repeat their motion time to 0.3 s in 1750 s and 0.2 s in
+370 s): the median keeps that and drops a single run's lagging event, and the training set stays
+one copy of the program, not 10-16 copies of the same inputs. As in
+:func:`nctwin.calibrate.calibrate`, runs of an assumed rapid override are predicted but never
+trained on.
+
+**Pieces.** Hurco02 has two programs (OP1, OP3) and Hurco04 seven plates, one run each:
+training on one program would leave no whole program to validate on. Each training program is
+cut at its tool changes (:func:`tool_sections`): each tool's section is a sub-program, and
+validation holds out whole sections (``TrainConfig.val_share`` of them, at least one). The
+held-out program's data take part in neither training nor validation (:func:`fold_data`).
+
+**Budget.** Each network trains on at most :data:`MAX_TRAIN_ROWS` moves of its fold's pieces
+(:func:`learned_predictions` says why and what it costs).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..calibrate import (
+    ProgramLines,
+    RunTimes,
+    _machine,
+    _plateaus,
+    _window,
+    axis_rapid_mm_s,
+    program_lines,
+    run_overrides,
+    run_times,
+)
+from ..controls import PlannerControl
+from ..estimate.learned import (
+    BILSTM_CONFIG,
+    MoveData,
+    axis_nn_move_times,
+    bilstm_move_times,
+    move_data,
+    train_configs,
+)
+from ..identify import at_rapid_override
+from ..learn.train import TrainConfig, Trained, _split, fit
+from ..methods import sun2022
+from ..mtconnect import Run, Track, parse_program, read_log, runs, validate
+from ..paths import nist_dir
+from ..runner import run_tasks
+from ..toolpath import MotionKind, Toolpath
+
+__all__ = [
+    "CONTROL",
+    "MAX_EPOCHS",
+    "MAX_TRAIN_ROWS",
+    "MAX_VAL_ROWS",
+    "METHODS",
+    "MIN_PIECE_MOVES",
+    "WAIT_M_CODES",
+    "Fold",
+    "HeldOutRun",
+    "LoggedRun",
+    "Spans",
+    "axis_targets",
+    "block_spans",
+    "configs",
+    "fold_data",
+    "learned_predictions",
+    "move_feeds",
+    "non_motion_lines",
+    "program_move_data",
+    "run_move_data",
+    "sample_windows",
+    "span_targets",
+    "tool_sections",
+    "train_folds",
+    "training_sets",
+]
+
+#: The control the features are computed with (the calibration's planner settings).
+CONTROL = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
+
+#: Tool sections shorter than this many moves join the next (:func:`tool_sections`).
+MIN_PIECE_MOVES = 256
+
+#: M-codes the control waits at: program stop, optional stop, spindle start (CW, CCW) and stop,
+#: tool change, spindle orientation. Coolant (M7-M9) moves on at once.
+WAIT_M_CODES = (0, 1, 3, 4, 5, 6, 19)
+
+
+@dataclass(frozen=True)
+class Spans:
+    """The spans a run's ``Block_Number`` events time over a motion window.
+
+    Parameters
+    ----------
+    first_line, end_line : numpy.ndarray of int64, shape (S,)
+        Span ``s`` times the lines ``first_line[s] .. end_line[s] - 1``: from the event of
+        ``first_line[s]`` to the event of the next observed line ``end_line[s]``.
+    t0_s, t1_s : numpy.ndarray, shape (S,)
+        The times of those two events (s).
+    """
+
+    first_line: np.ndarray
+    end_line: np.ndarray
+    t0_s: np.ndarray
+    t1_s: np.ndarray
+
+    @property
+    def time_s(self) -> np.ndarray:
+        """The time of each span (s), shape (S,)."""
+        return self.t1_s - self.t0_s
+
+
+def block_spans(block_t_s: np.ndarray, block: np.ndarray, first_cut: int, m30: int) -> Spans:
+    """The spans between consecutive block events over the motion window.
+
+    Parameters
+    ----------
+    block_t_s, block : numpy.ndarray, shape (n,)
+        A run's ``Block_Number`` events (:attr:`nctwin.mtconnect.Run.block_t_s`,
+        :attr:`~nctwin.mtconnect.Run.block`).
+    first_cut, m30 : int
+        The window's first line and its M30 line (:class:`~nctwin.calibrate.ProgramLines`).
+
+    Returns
+    -------
+    Spans
+        From the first event at or past ``first_cut`` (where ``Verdict.motion_s`` starts) to
+        the first event at or past ``m30`` (where it ends); events of a line not past the one
+        before (none in a valid run) are skipped.
+    """
+    t, b = np.asarray(block_t_s, float), np.asarray(block, np.int64)
+    keep = b >= first_cut
+    t, b = t[keep], b[keep]
+    end = np.flatnonzero(b >= m30)
+    if end.size:
+        t, b = t[: end[0] + 1], b[: end[0] + 1]
+    ahead = np.r_[True, b[1:] > np.maximum.accumulate(b)[:-1]] if b.size else b.astype(bool)
+    t, b = t[ahead], b[ahead]
+    return Spans(b[:-1], b[1:], t[:-1], t[1:])
+
+
+def non_motion_lines(lines: ProgramLines, tp: Toolpath) -> np.ndarray:
+    """The lines of a program that carry time no move accounts for.
+
+    Parameters
+    ----------
+    lines : ProgramLines
+        The program's tool changes (from the ``G28`` line to the ``M6`` line), spindle starts
+        (the ``M3``/``M4`` line and the next line with a block) and optional stops.
+    tp : Toolpath
+        The whole program: its dwells' lines and the lines of :data:`WAIT_M_CODES`.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (k,)
+        Sorted, unique 1-based lines.
+    """
+    spans = np.concatenate([lines.tool_changes, lines.spindle_starts]).reshape(-1, 2)
+    ranged = [np.arange(a, z + 1) for a, z in spans]
+    ev = tp.events
+    waits = ev["line"][(ev["word"] == "M") & np.isin(ev["value"], WAIT_M_CODES)]
+    dwells = tp.line[tp.kind == MotionKind.DWELL]
+    parts = [*ranged, lines.optional_stops, waits, dwells]
+    return np.unique(np.concatenate([np.asarray(p, np.int64).ravel() for p in parts]))
+
+
+def span_targets(
+    move_line: np.ndarray,
+    length_mm: np.ndarray,
+    feed_mm_s: np.ndarray,
+    spans: Spans,
+    non_motion: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Chien's per-move targets from the spans: the span's average feed and the log time ratio.
+
+    Parameters
+    ----------
+    move_line : numpy.ndarray of int64, shape (M,)
+        The program line of each move, in program order.
+    length_mm, feed_mm_s : numpy.ndarray, shape (M,)
+        Each move's length :math:`l_k` and feed feature :math:`F_k`.
+    spans : Spans
+        :func:`block_spans` (S spans).
+    non_motion : numpy.ndarray of int64, shape (k,)
+        :func:`non_motion_lines`.
+
+    Returns
+    -------
+    targets : numpy.ndarray, shape (M, 2)
+        The average feed :math:`\bar f` (mm/s) of the move's span, its length over its time,
+        and :math:`\ln (F_k \tilde t_k / l_k) = \ln (F_k / \bar f)` (the move's time at the
+        span's average feed); both NaN for a move in no span, in a span that holds a line of
+        ``non_motion`` or whose time is not positive.
+    span : numpy.ndarray of int64, shape (M,)
+        The span of each move (-1: none, or a span left NaN).
+    move_t_s : numpy.ndarray, shape (M, 2)
+        The start and end time of each move, its span's time laid over the span's moves in
+        proportion to their length (NaN where ``span`` is -1).
+    """
+    move_line = np.asarray(move_line, np.int64)
+    length = np.asarray(length_mm, float)
+    k = np.searchsorted(spans.first_line, move_line, side="right") - 1
+    inside = k >= 0
+    inside[inside] = move_line[inside] < spans.end_line[k[inside]]
+    # spans that hold a non-motion line, or no time
+    held = np.searchsorted(non_motion, spans.first_line, side="left")
+    blocked = (held < len(non_motion)) & (
+        np.r_[non_motion, np.iinfo(np.int64).max][held] < spans.end_line
+    )
+    ok_span = ~blocked & (spans.time_s > 0)
+    span = np.where(inside, k, -1)
+    span[inside] = np.where(ok_span[k[inside]], k[inside], -1)
+    use = span >= 0
+    span_len = np.bincount(span[use], weights=length[use], minlength=len(spans.first_line))
+    targets = np.full((len(move_line), 2), np.nan)
+    move_t = np.full((len(move_line), 2), np.nan)
+    if use.any():
+        s = span[use]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            avg = span_len[s] / spans.time_s[s]
+            targets[use, 0] = np.where(avg > 0, avg, np.nan)
+            targets[use, 1] = np.log(np.asarray(feed_mm_s, float)[use] / targets[use, 0])
+        # cumulative length within each span (moves of a span are consecutive)
+        cum = np.cumsum(length[use])
+        first = np.r_[True, s[1:] != s[:-1]]
+        base = np.maximum.accumulate(np.where(first, cum - length[use], 0.0))
+        end = cum - base
+        share0, share1 = (end - length[use]) / span_len[s], end / span_len[s]
+        dt = spans.time_s[s]
+        move_t[use, 0] = spans.t0_s[s] + share0 * dt
+        move_t[use, 1] = spans.t0_s[s] + share1 * dt
+    return targets, span, move_t
+
+
+def axis_targets(
+    directions: np.ndarray, span: np.ndarray, move_t_s: np.ndarray, spans: Spans, feed: Track
+) -> np.ndarray:
+    """Sun's per-axis targets: the logged feed record nearest each move, times its direction.
+
+    Parameters
+    ----------
+    directions : numpy.ndarray, shape (M, 3)
+        Each move's unit direction.
+    span, move_t_s : numpy.ndarray, shapes (M,) and (M, 2)
+        :func:`span_targets`' span of each move and its time interval.
+    spans : Spans
+    feed : Track
+        The run's ``Feed_Rate`` records (:attr:`nctwin.mtconnect.Run.feed_mm_s`, mm/s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (M, 3)
+        The record nearest in time to the move's interval (one inside it where any is: the
+        one nearest its middle) among the records within the move's span, times the move's
+        direction; NaN where the span holds no record or ``span`` is -1.
+    """
+    span = np.asarray(span, np.int64)
+    out = np.full((len(span), 3), np.nan)
+    use = span >= 0
+    if not use.any() or not feed.t_s.size:
+        return out
+    s = span[use]
+    mid = move_t_s[use].mean(axis=1)
+    lo = np.searchsorted(feed.t_s, spans.t0_s[s], side="left")  # first record in the span
+    hi = np.searchsorted(feed.t_s, spans.t1_s[s], side="right") - 1  # last record in it
+    j = np.clip(np.searchsorted(feed.t_s, mid), lo, np.maximum(hi, lo))  # first at/after mid
+    before = np.clip(j - 1, lo, None)
+    pick = np.where(
+        np.abs(feed.t_s[np.minimum(before, len(feed.t_s) - 1)] - mid)
+        <= np.abs(feed.t_s[np.minimum(j, len(feed.t_s) - 1)] - mid),
+        before,
+        j,
+    )
+    value = np.where(hi >= lo, feed.value[np.minimum(pick, len(feed.t_s) - 1)], np.nan)
+    out[use] = value[:, None] * np.asarray(directions, float)[use]
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class LoggedRun:
+    """A valid run of a machine's logs: the :class:`~nctwin.mtconnect.Run` (its events) and its
+    :class:`~nctwin.calibrate.RunTimes` (what :func:`nctwin.calibrate.machine_runs` returns)."""
+
+    run: Run
+    times: RunTimes
+
+
+@functools.cache
+def _nist_runs(machine_name: str) -> tuple[tuple[LoggedRun, ...], dict, pd.DataFrame]:
+    """:func:`nctwin.calibrate.machine_runs` of the shipped logs, the runs' events kept."""
+    folder = nist_dir()
+    texts = {p.name: p.read_text() for p in sorted((folder / "nc").glob("*.NC"))}
+    out, programs, rapids = [], {}, []
+    for path in sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz")):
+        for run in runs(read_log(path)):
+            v = validate(run, texts)
+            if v.program is not None:
+                rapids += _plateaus(run, parse_program(v.program, texts[v.program]))
+            if not v.valid:
+                continue
+            if v.program not in programs:
+                programs[v.program] = program_lines(folder / "nc" / v.program)
+            out.append(LoggedRun(run, run_times(run, programs[v.program][0], v)))
+    if not out:
+        raise ValueError(f"no valid run of {machine_name} in the shipped logs")
+    columns = ["log", "program", "rapid_override_pct", "plateau_mm_s"]
+    return tuple(out), programs, pd.DataFrame(rapids, columns=columns)
+
+
+def run_move_data(
+    run: Run, lines: ProgramLines, tp: Toolpath, machine, name: str | None = None
+) -> MoveData:
+    """The moves of one run's motion window with the targets its log resolves.
+
+    Parameters
+    ----------
+    run : Run
+        A valid run of the program.
+    lines, tp : ProgramLines, Toolpath
+        The program (:func:`nctwin.calibrate.program_lines`); only the motion window's blocks,
+        ``tp.take(_window(tp, lines))``, are moves.
+    machine : Machine
+        The machine at the run's rapid override (features: :data:`CONTROL`).
+    name : str, optional
+        The data's name (default: the run's log).
+
+    Returns
+    -------
+    MoveData
+        :func:`~nctwin.estimate.learned.move_data` of the window (M moves) with ``targets``
+        (M, 2) of :func:`span_targets` and ``axis_targets`` (M, 3) of :func:`axis_targets`;
+        ``measured_s`` the window's time from the first to the last span event (the run's
+        ``Verdict.motion_s``).
+    """
+    data = move_data(name or run.log, tp.take(_window(tp, lines)), machine, CONTROL)
+    spans = block_spans(run.block_t_s, run.block, lines.first_cut, lines.m30)
+    y, span, move_t = span_targets(
+        data.moves.line, data.features[:, 1], data.features[:, 0], spans,
+        non_motion_lines(lines, tp),
+    )  # fmt: skip
+    ax = axis_targets(data.moves.directions, span, move_t, spans, run.feed_mm_s)
+    measured = float(spans.t1_s[-1] - spans.t0_s[0]) if len(spans.t0_s) else np.nan
+    return dataclasses.replace(data, targets=y, axis_targets=ax, measured_s=measured)
+
+
+def program_move_data(
+    runs_: Sequence[Run], lines: ProgramLines, tp: Toolpath, machine, name: str
+) -> MoveData:
+    """One program at one rapid override: the median over ``runs_`` of :func:`run_move_data`'s
+    targets, move by move (NaN ones left out; NaN where every run's is), shape (M, 2) and
+    (M, 3); ``measured_s`` the median of the runs' (see the module docstring for why)."""
+    each = [run_move_data(r, lines, tp, machine, name) for r in runs_]
+    if len(each) == 1:
+        return each[0]
+    with warnings.catch_warnings():  # "All-NaN slice": a move no run resolves stays NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        y = np.nanmedian(np.stack([d.targets for d in each]), axis=0)
+        ax = np.nanmedian(np.stack([d.axis_targets for d in each]), axis=0)
+    measured = float(np.median([d.measured_s for d in each]))
+    return dataclasses.replace(each[0], targets=y, axis_targets=ax, measured_s=measured)
+
+
+def tool_sections(data: MoveData, lines: ProgramLines) -> list[MoveData]:
+    """A program's moves cut at its tool changes inside the motion window: one piece per tool.
+
+    Parameters
+    ----------
+    data : MoveData
+        A program's window (M moves).
+    lines : ProgramLines
+        Its tool changes; a cut falls at each one's first (``G28``) line, so its moves go with
+        the tool that follows (their targets are NaN: the span holds the change).
+
+    Returns
+    -------
+    list of MoveData
+        In program order, named ``"{name}#{k}"`` (k from 0); each with its rows of
+        ``features`` (m_k, 7), ``targets`` (m_k, 2), ``axis_features`` (m_k, 3, 9),
+        ``axis_targets`` (m_k, 3); ``dwell_s`` 0, ``measured_s`` NaN. A section of fewer than
+        :data:`MIN_PIECE_MOVES` moves joins the next (the last one the one before): a
+        validation piece of a few moves would decide early stopping on noise (the plates'
+        first tools drill 9-14 moves). Pieces without a finite target are dropped.
+    """
+    piece = np.searchsorted(np.sort(lines.tool_changes[:, 0]), data.moves.line, side="right")
+    ids, counts = np.unique(piece, return_counts=True)
+    groups: list[list[int]] = []
+    pending: list[int] = []
+    size = 0
+    for i, c in zip(ids.tolist(), counts.tolist(), strict=True):
+        pending.append(i)
+        size += c
+        if size >= MIN_PIECE_MOVES:
+            groups.append(pending)
+            pending, size = [], 0
+    if pending and groups:
+        groups[-1] += pending
+    elif pending:
+        groups.append(pending)
+    out = []
+    for g in groups:
+        m = np.isin(piece, g)
+        if not np.isfinite(data.targets[m]).any():
+            continue
+        out.append(
+            dataclasses.replace(
+                data,
+                name=f"{data.name}#{len(out)}",
+                moves=data.moves.take(m),
+                features=data.features[m],
+                targets=data.targets[m],
+                axis_features=data.axis_features[m],
+                axis_targets=data.axis_targets[m],
+                dwell_s=0.0,
+                measured_s=np.nan,
+            )
+        )
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class HeldOutRun:
+    """A run of the held-out program, as its fold predicts it.
+
+    Parameters
+    ----------
+    log : str
+    override_pct : float
+        Its rapid override (:func:`nctwin.calibrate.run_overrides`; where assumed, the median
+        of the fold's training runs of a known override, as
+        :func:`nctwin.calibrate.predict_runs` does).
+    override_source : str
+    measured_s : float
+        Its ``Verdict.motion_s``.
+    data : MoveData
+        :func:`run_move_data` on the fold's machine at ``override_pct`` (its targets are for
+        figures only: nothing trains on them).
+    run : Run
+        Its events.
+    """
+
+    log: str
+    override_pct: float
+    override_source: str
+    measured_s: float
+    data: MoveData
+    run: Run
+
+
+@dataclass(frozen=True, eq=False)
+class Fold:
+    """One held-out program of one machine and what its networks may learn from.
+
+    Parameters
+    ----------
+    machine_name, program : str
+        The machine and the held-out program's file.
+    rapid_mm_s : float
+        The axis rapid read from the other programs' runs (:func:`nctwin.calibrate.
+        axis_rapid_mm_s`).
+    train_programs : tuple of str
+        The other programs.
+    pieces : tuple of MoveData
+        Their tool sections (:func:`tool_sections`) of :func:`program_move_data` per program
+        and rapid override, runs of an assumed override left out.
+    held_out : tuple of HeldOutRun
+        The held-out program's runs.
+    """
+
+    machine_name: str
+    program: str
+    rapid_mm_s: float
+    train_programs: tuple[str, ...]
+    pieces: tuple[MoveData, ...]
+    held_out: tuple[HeldOutRun, ...]
+
+
+def fold_data(machine_name: str, program: str) -> Fold:
+    """The :class:`Fold` of ``program`` held out of ``machine_name``'s valid runs, as
+    :func:`nctwin.calibrate.leave_one_program_out` builds it: the axis rapid from the other
+    programs' rapid plateaus, the training runs' overrides from it.
+
+    Raises
+    ------
+    ValueError
+        ``program`` has no valid run, or no other program a run of a known rapid override.
+    """
+    logged, programs, rapids = _nist_runs(machine_name)
+    train = [r for r in logged if r.times.program != program]
+    test = [r for r in logged if r.times.program == program]
+    if not test:
+        raise ValueError(f"{program} has no valid run of {machine_name}")
+    rapid_mm_s, _ = axis_rapid_mm_s(rapids[rapids["program"] != program], [r.times for r in train])
+    pct, source = run_overrides([r.times for r in train], rapid_mm_s)
+    known = source != "assumed"
+    if not known.any():
+        raise ValueError(f"no run of {machine_name} but {program}'s has a known rapid override")
+    machine = _machine(machine_name, rapid_mm_s)
+    groups: dict[tuple[str, float], list[Run]] = {}
+    for r, o, k in zip(train, pct, known, strict=True):
+        if not k:
+            continue
+        groups.setdefault((r.times.program, float(o)), []).append(r.run)
+    pieces = []
+    for (file, o), runs_ in sorted(groups.items()):
+        lines, tp = programs[file]
+        at = at_rapid_override(machine, o / 100)
+        pieces += tool_sections(program_move_data(runs_, lines, tp, at, f"{file}@{o:g}"), lines)
+    test_pct, test_source = run_overrides(
+        [r.times for r in test], rapid_mm_s, float(np.median(pct[known]))
+    )
+    lines, tp = programs[program]
+    held_out = tuple(
+        HeldOutRun(
+            r.run.log, float(o), str(s), r.times.motion_s,
+            run_move_data(r.run, lines, tp, at_rapid_override(machine, o / 100)), r.run,
+        )
+        for r, o, s in zip(test, test_pct, test_source, strict=True)
+    )  # fmt: skip
+    return Fold(machine_name, program, rapid_mm_s, tuple(sorted({f for f, _ in groups})),
+                tuple(pieces), held_out)  # fmt: skip
+
+
+#: The most training rows (moves) a network of a fold sees, and validation rows it checks.
+MAX_TRAIN_ROWS = 16384
+MAX_VAL_ROWS = 4096
+#: The epoch cap: far above where early stopping ends every training (``converged`` reports
+#: it), so that it never decides.
+MAX_EPOCHS = 5000
+#: The learned methods (:func:`learned_predictions`' ``method``).
+METHODS = ("bilstm", "axis_nn")
+
+
+def _columns(piece: MoveData, net: str) -> tuple[np.ndarray, np.ndarray]:
+    """A piece's inputs and targets for ``net``: ``"bilstm"`` or an axis, ``"x"``, ``"y"``,
+    ``"z"``."""
+    if net == "bilstm":
+        return piece.features, piece.targets
+    a = "xyz".index(net)
+    return piece.axis_features[:, a], piece.axis_targets[:, a : a + 1]
+
+
+def sample_windows(
+    xs: Sequence[np.ndarray], ys: Sequence[np.ndarray], window: int, max_rows: int
+) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """At most ``max_rows`` rows of pieces, as windows of ``window`` consecutive rows.
+
+    Parameters
+    ----------
+    xs, ys : sequences of numpy.ndarray, shapes (N_i, n_in) and (N_i, n_out)
+        The pieces' inputs and targets.
+    window, max_rows : int
+
+    Returns
+    -------
+    xs, ys : lists of numpy.ndarray, shapes (w_j, n_in) and (w_j, n_out)
+        The windows: each piece cut into consecutive windows of ``window`` rows from its
+        start (a shorter tail dropped; a piece shorter than ``window``, one window of its
+        rows), those with a finite target kept, and of these, evenly spaced over the pieces in
+        order, as many whole windows as ``max_rows`` holds (all where they fit). The same
+        rows for every seed.
+    """
+    cuts = []
+    for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
+        starts = range(0, max(len(x) - window, 0) + 1, window)
+        cuts += [(i, s) for s in starts if np.isfinite(y[s : s + window]).any()]
+    rows = [min(window, len(xs[i])) for i, _ in cuts]
+    if sum(rows) > max_rows:
+        n = max(max_rows // window, 1)
+        keep = np.unique(np.linspace(0, len(cuts) - 1, n).round().astype(int))
+        cuts = [cuts[k] for k in keep]
+    return (
+        [xs[i][s : s + window] for i, s in cuts],
+        [ys[i][s : s + window] for i, s in cuts],
+    )
+
+
+def training_sets(fold: Fold, net: str, config: TrainConfig) -> dict:
+    """What one network of ``fold`` trains on: ``xs``, ``ys`` (training windows of the
+    training pieces) and ``validation`` (windows of the validation pieces), from a split of the
+    pieces into training and validation pieces as :func:`nctwin.learn.train.fit` splits
+    programs (``config.seed``, ``config.val_share``, at least one), each side subsampled by
+    :func:`sample_windows` (:data:`MAX_TRAIN_ROWS`, :data:`MAX_VAL_ROWS`); ``train_pieces``,
+    ``val_pieces``: the pieces' names; ``n_rows``: the training pieces' rows before subsampling."""
+    train_idx, val_idx = _split(len(fold.pieces), config)
+    cols = [_columns(p, net) for p in fold.pieces]
+    w = config.window_lines
+    xs, ys = sample_windows(*zip(*(cols[i] for i in train_idx), strict=True), w, MAX_TRAIN_ROWS)
+    vx, vy = sample_windows(*zip(*(cols[i] for i in val_idx), strict=True), w, MAX_VAL_ROWS)
+    return {
+        "xs": xs,
+        "ys": ys,
+        "validation": (vx, vy),
+        "train_pieces": tuple(fold.pieces[i].name for i in train_idx),
+        "val_pieces": tuple(fold.pieces[i].name for i in val_idx),
+        "n_rows": int(sum(len(fold.pieces[i].features) for i in train_idx)),
+    }
+
+
+def configs(seed: int) -> tuple[TrainConfig, TrainConfig]:
+    """The BiLSTM's and the per-axis networks' training: :func:`nctwin.estimate.learned.
+    train_configs` (the LinuxCNC chapter's), the epoch cap raised to :data:`MAX_EPOCHS`."""
+    bilstm, axis = train_configs(seed)
+    return (dataclasses.replace(bilstm, max_epochs=MAX_EPOCHS),
+            dataclasses.replace(axis, max_epochs=MAX_EPOCHS))  # fmt: skip
+
+
+def _fit_task(net: str, sets: dict, config: TrainConfig, name: str) -> Trained:
+    """One network (a worker's task)."""
+    model = BILSTM_CONFIG if net == "bilstm" else sun2022.MODEL_CONFIG
+    return fit(model, config, sets["xs"], sets["ys"], validation=sets["validation"],
+               name=name, progress=False)  # fmt: skip
+
+
+def _nets(method: str) -> tuple[str, ...]:
+    return ("bilstm",) if method == "bilstm" else ("x", "y", "z")
+
+
+def _move_times(method: str, models: Sequence[Trained], data: MoveData) -> np.ndarray:
+    """The networks' own predicted time of each move (no floor), shape (M,)."""
+    if method == "bilstm":
+        return bilstm_move_times(models[0], data)
+    return axis_nn_move_times(models, data)
+
+
+def train_folds(
+    machine_name: str,
+    seeds: Sequence[int] = (0, 1, 2, 3, 4),
+    programs: Sequence[str] | None = None,
+    *,
+    n_jobs: int = 2,
+) -> tuple[list[Fold], dict]:
+    """The folds of ``machine_name`` (those holding out ``programs``; default every program)
+    and their networks, one per method, seed and net, trained in ``n_jobs`` processes.
+
+    Returns
+    -------
+    folds : list of Fold
+        One per held-out program, in file-name order.
+    models : dict
+        ``(program, method, seed)`` to ``(models, sets)``: the trained networks (one for
+        ``"bilstm"``, X, Y, Z for ``"axis_nn"``) and their :func:`training_sets`' summaries.
+    """
+    if programs is None:
+        programs = sorted({r.times.program for r in _nist_runs(machine_name)[0]})
+    folds = [fold_data(machine_name, p) for p in sorted(programs)]
+    tasks, keys, summaries = [], [], {}
+    for fold in folds:
+        for seed in seeds:
+            for method, config in zip(METHODS, configs(seed), strict=True):
+                for net in _nets(method):
+                    sets = training_sets(fold, net, config)
+                    name = f"nist_{machine_name}_{net if net == 'bilstm' else 'axis_' + net}"
+                    tasks.append((net, sets, config, name))
+                    keys.append((fold.program, method, seed))
+                    summaries.setdefault(keys[-1], []).append(
+                        {k: sets[k] for k in ("val_pieces", "n_rows")}
+                        | {"n_train_rows": int(sum(len(x) for x in sets["xs"]))}
+                    )
+    trained = run_tasks(_fit_task, tasks, n_jobs=n_jobs)
+    models: dict = {}
+    for key, model in zip(keys, trained, strict=True):
+        models.setdefault(key, []).append(model)
+    return folds, {k: (models[k], summaries[k]) for k in models}
+
+
+def learned_predictions(
+    machine_name: str, seeds: Sequence[int] = (0, 1, 2, 3, 4), *, n_jobs: int = 2
+) -> pd.DataFrame:
+    """Each program of ``machine_name`` held out and predicted by the BiLSTM and the per-axis
+    networks trained on the other programs' runs, once per seed.
+
+    **Budget.** Every fold of both machines, five seeds, trains in 100-120 s from an empty cache
+    on two cores shared with other work (98 s and 119 s measured, two worker processes,
+    :func:`nctwin.runner.run_tasks`; 20 s from a full cache). A Hurco04 fold's training
+    programs hold 250,000-315,000 moves (four or five plates of 63,000 moves, arcs in chords,
+    one geometry at other feeds), Hurco02's OP1 35,000; a BiLSTM step took about 5 ms per
+    32 windows of 128 moves on one core, so one epoch over all of a Hurco04 fold's moves would
+    take about 0.3 s, and its networks stop after 25-400 epochs.
+    Each network therefore sees at most :data:`MAX_TRAIN_ROWS` training moves, whole windows of
+    ``window_lines`` consecutive moves evenly spaced over its training pieces, and
+    :data:`MAX_VAL_ROWS` of its validation pieces (:func:`sample_windows`), the same rows for
+    every seed. The training settings are the LinuxCNC chapter's (:func:`configs`), the epoch
+    cap far above where early stopping ends every one (``converged``). Same seed, same numbers,
+    bit for bit (two runs from empty caches agree).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per held-out run, method and seed: ``program``, ``log``, ``start_s`` (the run's
+        start: a log may hold two runs), ``method``
+        (:data:`METHODS`), ``seed``, ``override_pct``, ``override_source``, ``measured_s`` (the
+        run's ``motion_s``), ``predicted_motion_s`` (the networks' own time of the motion
+        window's moves, no floor: no tool change, spindle start or optional stop time),
+        ``error_pct`` (signed, of the run), ``n_train_moves`` (the training pieces' moves),
+        ``n_train_rows`` (the rows trained on, per net), ``n_pieces`` (training and validation
+        pieces), ``val_pieces``, ``epochs`` and ``best_epoch`` (the most over the nets),
+        ``converged`` (every net stopped early), ``train_s`` (summed over the nets, as
+        recorded with the checkpoint).
+    """
+    folds, models = train_folds(machine_name, seeds, n_jobs=n_jobs)
+    rows = []
+    for fold in folds:
+        for method in METHODS:
+            for seed in seeds:
+                nets, sums = models[(fold.program, method, seed)]
+                cache: dict = {}
+                for run in fold.held_out:
+                    if run.override_pct not in cache:
+                        cache[run.override_pct] = float(_move_times(method, nets, run.data).sum())
+                    predicted = cache[run.override_pct]
+                    rows.append({
+                        "program": fold.program, "log": run.log,
+                        "start_s": run.run.start_s, "method": method,
+                        "seed": seed, "override_pct": run.override_pct,
+                        "override_source": run.override_source, "measured_s": run.measured_s,
+                        "predicted_motion_s": predicted,
+                        "error_pct": 100 * (predicted / run.measured_s - 1),
+                        "n_train_moves": sums[0]["n_rows"],
+                        "n_train_rows": sums[0]["n_train_rows"],
+                        "n_pieces": len(fold.pieces),
+                        "val_pieces": " ".join(sums[0]["val_pieces"]),
+                        "epochs": max(len(m.history["train"]) for m in nets),
+                        "best_epoch": max(m.best_epoch for m in nets),
+                        "converged": all(m.converged for m in nets),
+                        "train_s": sum(m.train_seconds for m in nets),
+                    })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def move_feeds(
+    machine_name: str, program: str, seeds: Sequence[int] = (0, 1, 2, 3, 4), *, n_jobs: int = 2
+) -> pd.DataFrame:
+    """The per-move logged and predicted feeds of one held-out program (for a figure), on its
+    run of median ``motion_s`` (the lower middle one of an even count).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A row per move of the motion window, in order: ``move``, ``line``, ``kind``
+        (:class:`~nctwin.toolpath.MotionKind`), ``length_mm``, ``feed_mm_s`` (the feed
+        feature: programmed, rapid at the run's override, within the axis limits),
+        ``t0_s`` (the move's start from the window's start, its span's time laid over its moves;
+        NaN where unresolved), ``logged_feed_mm_s`` (the span's average feed, Chien's target),
+        ``logged_axis_feed_mm_s`` (the norm of Sun's target, the nearest record),
+        ``bilstm_feed_mm_s`` and ``axis_nn_feed_mm_s`` (the move's length over its predicted
+        time, averaged over ``seeds``); ``attrs``: ``log``, ``measured_s``.
+    """
+    folds, models = train_folds(machine_name, seeds, [program], n_jobs=n_jobs)
+    fold = folds[0]
+    order = np.argsort([r.measured_s for r in fold.held_out], kind="stable")
+    run = fold.held_out[order[(len(order) - 1) // 2]]
+    d = run.data
+    length = d.features[:, 1]
+    out = {"move": np.arange(len(length)), "line": d.moves.line, "kind": d.moves.kind,
+           "length_mm": length, "feed_mm_s": d.features[:, 0]}  # fmt: skip
+    lines, tp = _nist_runs(machine_name)[1][program]
+    spans = block_spans(run.run.block_t_s, run.run.block, lines.first_cut, lines.m30)
+    _, _, move_t = span_targets(d.moves.line, length, d.features[:, 0], spans,
+                                non_motion_lines(lines, tp))  # fmt: skip
+    out["t0_s"] = move_t[:, 0] - (spans.t0_s[0] if len(spans.t0_s) else np.nan)
+    out["logged_feed_mm_s"] = d.targets[:, 0]
+    out["logged_axis_feed_mm_s"] = np.linalg.norm(d.axis_targets, axis=1)
+    for method in METHODS:
+        t = np.mean([_move_times(method, models[(program, method, s)][0], d) for s in seeds], 0)
+        out[f"{method}_feed_mm_s"] = length / t
+    frame = pd.DataFrame(out)
+    frame.attrs.update(log=run.log, measured_s=run.measured_s)
+    return frame
