@@ -73,6 +73,7 @@ __all__ = [
     "RunTimes",
     "axis_rapid_mm_s",
     "calibrate",
+    "held_out_predictions",
     "leave_one_program_out",
     "machine_runs",
     "predict_runs",
@@ -521,8 +522,11 @@ def calibrate(
     return dataclasses.replace(cal, fit_err_pct=err, best=best)
 
 
-def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) -> pd.DataFrame:
-    """Predicted ``motion_s`` and duration of each run by each of :data:`METHODS`, its rapids at
+def predict_runs(
+    cal: Calibration, times: Sequence[RunTimes], programs: dict, methods: Sequence[str] = METHODS
+) -> pd.DataFrame:
+    """Predicted ``motion_s`` and duration of each run by each of ``methods`` (of
+    :data:`METHODS`), its rapids at
     its rapid override (:func:`run_overrides` with ``cal``'s axis rapid; where assumed, the
     median of ``cal``'s runs of a known override).
 
@@ -542,7 +546,7 @@ def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) ->
     cache: dict = {}
     for r, o, s in zip(times, pct, source, strict=True):
         lines, tp = programs[r.program]
-        for method in METHODS:
+        for method in methods:
             key = (r.program, method, o)
             if key not in cache:
                 window = _window(tp, lines)
@@ -560,6 +564,35 @@ def predict_runs(cal: Calibration, times: Sequence[RunTimes], programs: dict) ->
     return pd.DataFrame(rows)
 
 
+def held_out_predictions(
+    name: str,
+    times: Sequence[RunTimes],
+    programs: dict,
+    rapids: pd.DataFrame | None = None,
+    *,
+    n_jobs: int = 2,
+) -> tuple[pd.DataFrame, dict[str, Calibration]]:
+    """Each program's runs predicted (:func:`predict_runs`) by a calibration on the other
+    programs' runs (and on the other programs' rows of ``rapids``).
+
+    Returns
+    -------
+    rows : pandas.DataFrame
+        :func:`predict_runs`' rows of every held-out run, plus ``chosen`` (the method is the
+        one its calibration picked on its own runs).
+    calibrations : dict of str to Calibration
+        The calibration each program was predicted by, by file name.
+    """
+    parts, cals = [], {}
+    for file in sorted({r.program for r in times}):
+        train = [r for r in times if r.program != file]
+        other = None if rapids is None else rapids[rapids["program"] != file]
+        cals[file] = cal = calibrate(name, train, programs, other, n_jobs=n_jobs)
+        pred = predict_runs(cal, [r for r in times if r.program == file], programs)
+        parts.append(pred.assign(chosen=pred["method"] == cal.best))
+    return pd.concat(parts, ignore_index=True), cals
+
+
 def leave_one_program_out(
     name: str,
     times: Sequence[RunTimes],
@@ -568,8 +601,7 @@ def leave_one_program_out(
     *,
     n_jobs: int = 2,
 ) -> pd.DataFrame:
-    """Each program's runs predicted by a calibration on the other programs' runs (and on the
-    other programs' rows of ``rapids``).
+    """:func:`held_out_predictions` by held-out program and method, medians over its runs.
 
     Returns
     -------
@@ -582,25 +614,20 @@ def leave_one_program_out(
         ``chosen`` (the method the calibration picked on its own runs).
     """
     rows = []
-    for file in sorted({r.program for r in times}):
-        train = [r for r in times if r.program != file]
-        test = [r for r in times if r.program == file]
-        other = None if rapids is None else rapids[rapids["program"] != file]
-        cal = calibrate(name, train, programs, other, n_jobs=n_jobs)
-        pred = predict_runs(cal, test, programs)
-        for method, g in pred.groupby("method", sort=False):
-            measured = float(g["measured_s"].median())
-            predicted = float(g["predicted_s"].median())
-            cycle = float(g["measured_cycle_s"].median())
-            predicted_cycle = float(g["predicted_cycle_s"].median())
-            used = zip(g["override_pct"], g["override_source"], strict=True)
-            override = sorted({f"{o:g} % {s}" for o, s in used})
-            rows.append({"program": file, "method": method, "runs": len(g),
-                         "override": ", ".join(override), "median_measured_s": measured,
-                         "predicted_s": predicted, "error_pct": 100 * (predicted / measured - 1),
-                         "median_cycle_s": cycle, "predicted_cycle_s": predicted_cycle,
-                         "cycle_error_pct": 100 * (predicted_cycle / cycle - 1),
-                         "chosen": method == cal.best})  # fmt: skip
+    pred, _ = held_out_predictions(name, times, programs, rapids, n_jobs=n_jobs)
+    for (file, method), g in pred.groupby(["program", "method"], sort=False):
+        measured = float(g["measured_s"].median())
+        predicted = float(g["predicted_s"].median())
+        cycle = float(g["measured_cycle_s"].median())
+        predicted_cycle = float(g["predicted_cycle_s"].median())
+        used = zip(g["override_pct"], g["override_source"], strict=True)
+        override = sorted({f"{o:g} % {s}" for o, s in used})
+        rows.append({"program": file, "method": method, "runs": len(g),
+                     "override": ", ".join(override), "median_measured_s": measured,
+                     "predicted_s": predicted, "error_pct": 100 * (predicted / measured - 1),
+                     "median_cycle_s": cycle, "predicted_cycle_s": predicted_cycle,
+                     "cycle_error_pct": 100 * (predicted_cycle / cycle - 1),
+                     "chosen": bool(g["chosen"].iloc[0])})  # fmt: skip
     return pd.DataFrame(rows)
 
 
