@@ -4,6 +4,7 @@ Hurco logs."""
 
 from __future__ import annotations
 
+import dataclasses
 from datetime import date
 
 import numpy as np
@@ -90,7 +91,7 @@ def _runs(lines, cut_s: float, n: int = 3) -> list[RunTimes]:
         motion = cut_s + tc + spindle.sum() + 0.5
         out.append(RunTimes(f"run{k}", lines.file, 500.0, np.nan, motion, motion + 8.0 + 3 * d,
                             4.0 + d, 1.0 + d, np.array([3.0 + d, tc]), spindle,
-                            np.array([0.5 + d])))  # fmt: skip
+                            np.array([0.5 + d]), 4, 7.0 + 2 * d))  # fmt: skip
     return out
 
 
@@ -104,6 +105,11 @@ def test_calibrate_recovers_the_hand_made_times(hand_program):
     # the tool change's G28 line moves Z from 0 to the reference at Z 0: no motion to remove
     assert seq.tool_change_s == pytest.approx(12.0)
     assert seq.first_tool_change_s == pytest.approx(3.0)  # T1 M6, before any spindle start
+    # a run whose first event comes past the first M6 (the control changed the tool before it
+    # logged a line) times the tool change in its opening, not in its program start
+    late = [dataclasses.replace(r, program_start_s=r.opening_s, first_line=5) for r in times]
+    seq2 = calibrate("hand", times + late, {lines.file: (lines, tp)}, n_jobs=1).sequence
+    assert (seq2.program_start_s, seq2.first_tool_change_s) == pytest.approx((4.0, 3.0))
     assert seq.spindle_start_s == pytest.approx(2.0)
     assert seq.spindle_start_s_per_krpm == pytest.approx(1.0)
     assert seq.optional_stop_s == pytest.approx(0.5)

@@ -26,15 +26,18 @@ identified rapid feed (what a motion estimator adds back when it times the same 
   travel to the real home above the program's ``G28`` point.
 * **First tool change** (:attr:`SequenceControl.first_tool_change_s`): the ``Tn M6`` line
   before the program's first spindle start, where the spindle is at rest and no return comes
-  before it (on the shipped runs 3-6 s against about 14 s for the others).
+  before it. The control may start it before it logs any line (most Hurco04 runs log their
+  first event past it), so it is timed from the run's start to the first event past its line,
+  less the program start.
 * **Spindle start**: from the ``S.. M3`` line to the line after it, both included: the control
   moves on only once the spindle is at speed. A constant where the calibration runs command
   one speed, a line in the speed where they command several
   (:attr:`SequenceControl.spindle_start_s_per_krpm`).
 * **Optional stop** (:attr:`SequenceControl.optional_stop_s`): an ``M01`` line outside a tool
   change; none of the shipped programs has one, so it stays 0 ("not identified").
-* **Program start / end**: the run's start to its first block event; its M30 line's event to
-  the run's end (PROGRAM_COMPLETED).
+* **Program start / end**: the run's start to its first block event, over the runs whose
+  first event is not past the first tool change; its M30 line's event to the run's end
+  (PROGRAM_COMPLETED).
 
 :func:`calibrate` fits them and the motion models on some runs, :func:`predict_runs` predicts
 ``Verdict.motion_s`` and the duration of others, :func:`leave_one_program_out` does both with
@@ -192,6 +195,11 @@ class RunTimes:
     tool_change_s, spindle_start_s, optional_stop_s : numpy.ndarray
         One span per tool change, spindle start, optional stop of the program (NaN where the
         log shows no event for it), in :class:`ProgramLines` order.
+    first_line : int
+        The line of the run's first block event.
+    opening_s : float
+        The run's start to the first block event past the ``M6`` line of the program's first
+        tool change (:func:`_first_changes`); NaN where it has none.
     """
 
     log: str
@@ -205,11 +213,16 @@ class RunTimes:
     tool_change_s: np.ndarray
     spindle_start_s: np.ndarray
     optional_stop_s: np.ndarray
+    first_line: int = 0
+    opening_s: float = np.nan
 
 
 def run_times(run: Run, lines: ProgramLines, verdict: Verdict) -> RunTimes:
     """The :class:`RunTimes` of the valid ``run`` on the program ``lines``."""
     t, b = run.block_t_s, run.block
+    m6 = _first_m6(lines)
+    past = np.flatnonzero(b > m6) if m6 else np.array([], int)
+    opening = float(t[past[0]] - run.start_s) if past.size else np.nan
     return RunTimes(
         run.log,
         lines.file,
@@ -222,7 +235,21 @@ def run_times(run: Run, lines: ProgramLines, verdict: Verdict) -> RunTimes:
         np.array([span_s(t, b, a, z) for a, z in lines.tool_changes]),
         np.array([span_s(t, b, a, z) for a, z in lines.spindle_starts]),
         np.array([span_s(t, b, a, a) for a in lines.optional_stops]),
+        int(b[0]),
+        opening,
     )
+
+
+def _first_changes(lines: ProgramLines) -> np.ndarray:
+    """Mask of ``lines.tool_changes`` before the first spindle start (shape (k,))."""
+    first = lines.spindle_starts[0, 0] if len(lines.spindle_starts) else np.inf
+    return lines.tool_changes[:, 1] < first
+
+
+def _first_m6(lines: ProgramLines) -> int:
+    """The ``M6`` line of the program's first tool change before any spindle start (0: none)."""
+    first = lines.tool_changes[_first_changes(lines)]
+    return int(first[0, 1]) if len(first) else 0
 
 
 def machine_runs(
@@ -393,12 +420,6 @@ class Calibration:
     runs: tuple
 
 
-def _first_changes(lines: ProgramLines) -> np.ndarray:
-    """Mask of ``lines.tool_changes`` before the first spindle start (shape (k,))."""
-    first = lines.spindle_starts[0, 0] if len(lines.spindle_starts) else np.inf
-    return lines.tool_changes[:, 1] < first
-
-
 def _sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
     """The non-motion time ``seq`` gives the motion window of a program (s), or (``window``
     False) its lines before the window, where the first approach ends."""
@@ -450,8 +471,7 @@ def calibrate(
     rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
     pct, source = run_overrides(times, rapid_mm_s)
     machine = _machine(name, rapid_mm_s)
-    net: dict[str, list] = {"tool_change": [], "first_tool_change": [], "spindle_start": [],
-                            "optional_stop": []}  # fmt: skip
+    net: dict[str, list] = {"tool_change": [], "spindle_start": [], "optional_stop": []}
     rpm: list[float] = []
     for r, o in zip(times, pct, strict=True):
         lines, tp = programs[r.program]
@@ -464,8 +484,6 @@ def calibrate(
             inside = spans[:, 0] >= lines.first_cut  # the window's: the others are the start's
             motion = np.array([blocks[m].sum() for m in _span_blocks(tp, spans[inside])])
             net[key] += list(gross[inside] - motion)
-        first = _first_changes(lines)
-        net["first_tool_change"] += list(r.tool_change_s[first])  # no motion on an M6 line
         rpm += list(lines.spindle_rpm[lines.spindle_starts[:, 0] >= lines.first_cut])
     rpm_arr = np.asarray(rpm)
     residuals = {}
@@ -477,14 +495,19 @@ def calibrate(
         slope, icpt = 0.0, float(np.nanmedian(med["spindle_start"]))
     residuals["spindle_start"] = med["spindle_start"][ok] - (icpt + slope * rpm_arr[ok] / 1000.0)
     fitted = {}
-    for key in ("tool_change", "first_tool_change", "optional_stop"):
+    for key in ("tool_change", "optional_stop"):
         v = med[key][np.isfinite(med[key])]
-        fitted[key] = float(np.median(v)) if v.size else (None if key[0] == "f" else 0.0)
-        residuals[key] = v - (fitted[key] or 0.0)
-    for key in ("program_start", "program_end"):
-        v = np.array([getattr(r, f"{key}_s") for r in times])
+        fitted[key] = float(np.median(v)) if v.size else 0.0
+        residuals[key] = v - fitted[key]
+    early = [r for r in times if r.first_line <= (_first_m6(programs[r.program][0]) or np.inf)]
+    for key, runs_ in (("program_start", early or times), ("program_end", times)):
+        v = np.array([getattr(r, f"{key}_s") for r in runs_])
         fitted[key] = float(np.median(v))
         residuals[key] = v - fitted[key]
+    opening = np.array([r.opening_s for r in times])
+    v = opening[np.isfinite(opening)] - fitted["program_start"]
+    fitted["first_tool_change"] = float(np.median(v)) if v.size else None  # no motion on M6
+    residuals["first_tool_change"] = v - (fitted["first_tool_change"] or 0.0)
     seq = SequenceControl(
         tool_change_s=fitted["tool_change"],
         first_tool_change_s=fitted["first_tool_change"],
