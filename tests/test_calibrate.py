@@ -12,20 +12,17 @@ import pandas as pd
 import pytest
 
 from nctwin.calibrate import (
-    RunTimes,
     axis_rapid_mm_s,
     calibrate,
     leave_one_program_out,
-    machine_runs,
-    program_lines,
     run_overrides,
-    span_s,
     write_profile,
 )
 from nctwin.cli import main
 from nctwin.controls import SequenceControl
 from nctwin.estimate import cam
 from nctwin.machine import Machine, Profile
+from nctwin.runtimes import RunTimes, machine_runs, program_lines, span_s
 
 #: A hand-made program (file lines 1-21): a tool change before the first cut (line 5) and one
 #: after it, two spindle starts (1000 and 3000 rev/min) whose lines move nothing, an optional

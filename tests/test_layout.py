@@ -20,7 +20,7 @@ LAYERS = (
     ("physics",),
     ("kernel",),
     ("programs",),
-    ("recordings", "mtconnect"),
+    ("recordings", "mtconnect", "runtimes"),
     ("learn",),
     ("methods",),
     ("estimate",),

@@ -9,10 +9,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from nctwin.calibrate import _machine, program_lines
+from nctwin.calibrate import base_machine
 from nctwin.chapters import nist_learned as nl
+from nctwin.chapters import nist_targets as nt
 from nctwin.learn.train import fit
 from nctwin.mtconnect import Run, Track
+from nctwin.runtimes import program_lines
 
 #: File lines 1-17: tool changes at lines 4 and 10-12 (G28, M01, M6), spindle starts at 5-6
 #: and 13-14; the window is lines 7-15 (first cut to before M30). At F600 (10 mm/s) the moves
@@ -68,12 +70,12 @@ def hand(tmp_path):
 def test_non_motion_lines(hand):
     lines, tp = hand
     # tool changes 4 and 10-12, spindle starts 5-6 and 13-14, the M-codes that wait
-    assert nl.non_motion_lines(lines, tp).tolist() == [4, 5, 6, 10, 11, 12, 13, 14]
+    assert nt.non_motion_lines(lines, tp).tolist() == [4, 5, 6, 10, 11, 12, 13, 14]
 
 
 def test_block_spans_from_the_first_cut_to_m30():
     run = _run(events=((6, 90.0), *EVENTS, (17, 130.0)))
-    s = nl.block_spans(run.block_t_s, run.block, first_cut=7, m30=16)
+    s = nt.block_spans(run.block_t_s, run.block, first_cut=7, m30=16)
     assert s.first_line.tolist() == [7, 9, 10, 14, 15]
     assert s.end_line.tolist() == [9, 10, 14, 15, 16]
     assert s.time_s.tolist() == [6.0, 3.0, 11.0, 1.0, 4.0]
@@ -81,7 +83,7 @@ def test_block_spans_from_the_first_cut_to_m30():
 
 def test_targets_by_hand(hand):
     lines, tp = hand
-    data = nl.run_move_data(_run(), lines, tp, _machine("hand", 500.0))
+    data = nl.run_move_data(_run(), lines, tp, base_machine("hand", 500.0))
     assert data.moves.line.tolist() == [7, 8, 9, 14, 15]  # G28 Z0 moves nothing here
     assert data.features[:, 0].tolist() == [10.0] * 5
     # lines 7-8 (line 8 never shows): 30 mm in 6 s; line 9: 30 mm in 3 s; line 14 lies in the
@@ -99,9 +101,9 @@ def test_targets_by_hand(hand):
 
 
 def test_span_times_and_non_positive_spans():
-    spans = nl.Spans(np.array([1, 3, 4]), np.array([3, 4, 6]), np.array([0.0, 2.0, 2.0]),
+    spans = nt.Spans(np.array([1, 3, 4]), np.array([3, 4, 6]), np.array([0.0, 2.0, 2.0]),
                      np.array([2.0, 2.0, 5.0]))  # fmt: skip
-    y, span, t = nl.span_targets(
+    y, span, t = nt.span_targets(
         np.array([1, 2, 2, 3, 5, 6]), np.array([1.0, 2.0, 1.0, 4.0, 3.0, 1.0]),
         np.full(6, 3.0), spans, np.array([], np.int64),
     )  # fmt: skip
@@ -113,12 +115,12 @@ def test_span_times_and_non_positive_spans():
 
 
 def test_axis_targets_take_the_nearest_record_within_the_span():
-    spans = nl.Spans(np.array([1, 2]), np.array([2, 3]), np.array([0.0, 1.0]),
+    spans = nt.Spans(np.array([1, 2]), np.array([2, 3]), np.array([0.0, 1.0]),
                      np.array([1.0, 3.0]))  # fmt: skip
     feed = _track(((0.2, 7.0), (0.7, 8.0), (3.5, 9.0)))
     directions = np.array([[0.6, 0.8, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
     move_t = np.array([[0.0, 0.3], [0.3, 1.0], [1.0, 3.0]])
-    ax = nl.axis_targets(directions, np.array([0, 0, 1]), move_t, spans, feed)
+    ax = nt.axis_targets(directions, np.array([0, 0, 1]), move_t, spans, feed)
     np.testing.assert_allclose(ax[0], [4.2, 5.6, 0.0])  # 0.2 s, in its interval
     np.testing.assert_allclose(ax[1], [0.0, 0.0, -8.0])  # 0.7 s nearest its middle, 0.65 s
     assert np.isnan(ax[2]).all()  # no record within 1-3 s (3.5 s is past the span)
@@ -126,7 +128,7 @@ def test_axis_targets_take_the_nearest_record_within_the_span():
 
 def test_tool_sections_cut_at_the_tool_changes(hand, monkeypatch):
     lines, tp = hand
-    data = nl.run_move_data(_run(), lines, tp, _machine("hand", 500.0), name="HAND")
+    data = nl.run_move_data(_run(), lines, tp, base_machine("hand", 500.0), name="HAND")
     monkeypatch.setattr(nl, "MIN_PIECE_MOVES", 1)
     pieces = nl.tool_sections(data, lines)
     assert [p.name for p in pieces] == ["HAND#0", "HAND#1"]

@@ -13,11 +13,8 @@ run shows neither, the median of the others' (``assumed``: such runs are predict
 fitted); every prediction of a run runs its rapids at it
 (:func:`nctwin.identify.at_rapid_override`).
 
-The logs time a program's lines, not its motion: ``Block_Number`` names the line executing
-from then on, logged on change, so a short line may never show and a line's event may lag its
-start. The times are therefore read as spans between events (:func:`span_s`: from the first
-event at or past one line to the first past another), never as one line's duration, and every
-non-motion time is *net*: a span's time minus the CAM time of the span's own blocks at the
+The logs time spans of a program's lines between block events (:mod:`nctwin.runtimes`), and
+every non-motion time is *net*: a span's time minus the CAM time of the span's own blocks at the
 identified rapid feed (what a motion estimator adds back when it times the same blocks).
 
 * **Tool change** (:attr:`SequenceControl.tool_change_s`): from the ``G91 G28 Z0.`` line
@@ -47,7 +44,6 @@ each program held out, :func:`write_profile` writes the machine's profile file.
 from __future__ import annotations
 
 import dataclasses
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import date
@@ -59,11 +55,9 @@ import pandas as pd
 from .controls import AccDecControl, FirControl, PlannerControl, SequenceControl
 from .estimate import block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner
-from .gcode import parse_file
 from .identify import at_rapid_override, fit_block_overlap, fit_fir, fit_planner
 from .machine import Machine, write_control
-from .mtconnect import Run, Verdict, parse_program, read_log, runs, steady_feed, validate
-from .paths import nist_dir
+from .runtimes import ProgramLines, RunTimes, first_changes, first_m6, motion_window
 from .toolpath import Toolpath
 
 __all__ = [
@@ -72,18 +66,14 @@ __all__ = [
     "LEE_PERIOD_S",
     "METHODS",
     "Calibration",
-    "ProgramLines",
-    "RunTimes",
     "axis_rapid_mm_s",
+    "base_machine",
     "calibrate",
     "held_out_predictions",
     "leave_one_program_out",
-    "machine_runs",
     "predict_runs",
-    "program_lines",
     "run_overrides",
-    "run_times",
-    "span_s",
+    "sequence_s",
     "write_profile",
 ]
 
@@ -98,223 +88,12 @@ LEE_PERIOD_S = 0.001
 #: The axis acceleration (mm/s^2) of the machine the FIR kernel scales (its ``acc_scale``).
 BASE_ACCELERATION_MM_S2 = 1000.0
 
-_G28 = re.compile(r"G0*28(?![0-9.])")
-_COMMENT = re.compile(r"\([^)]*\)")
-
-
-@dataclass(frozen=True)
-class ProgramLines:
-    """The lines of one program that :mod:`nctwin.calibrate` times (1-based file lines).
-
-    Parameters
-    ----------
-    file : str
-    first_cut, m30 : int
-        The first feed line (where ``Verdict.motion_s`` starts) and the M30 line.
-    tool_changes : numpy.ndarray
-        Shape (k, 2): the ``G28`` line before each ``M6`` line (the ``M6`` line itself where
-        none is within 3 lines) and the ``M6`` line.
-    spindle_starts : numpy.ndarray
-        Shape (m, 2): each line with ``M3``/``M4`` and the next line with a block.
-    spindle_rpm : numpy.ndarray
-        Shape (m,): the S word in force at each spindle start (rev/min).
-    optional_stops : numpy.ndarray
-        Shape (j,): ``M01`` lines outside every tool change.
-    """
-
-    file: str
-    first_cut: int
-    m30: int
-    tool_changes: np.ndarray
-    spindle_starts: np.ndarray
-    spindle_rpm: np.ndarray
-    optional_stops: np.ndarray
-
-
-def program_lines(path: str | Path) -> tuple[ProgramLines, Toolpath]:
-    """Read a program (:func:`nctwin.gcode.parse_file`) and find its timed lines."""
-    path = Path(path)
-    tp = parse_file(path)
-    text = path.read_text().split("\n")
-    g28 = [i for i, s in enumerate(text, 1) if _G28.search(_COMMENT.sub("", s.upper()))]
-    ev = tp.events
-    m = ev[ev["word"] == "M"]
-    block_lines = np.unique(tp.line)
-    changes = []
-    for line in m["line"][m["value"] == 6]:
-        before = [g for g in g28 if line - 3 <= g < line]
-        changes.append((before[0] if before else line, line))
-    changes_arr = np.array(changes, np.int64).reshape(-1, 2)
-    s_lines, rpm = ev["line"][ev["word"] == "S"], ev["value"][ev["word"] == "S"]
-    starts, speeds = [], []
-    for line in np.unique(m["line"][np.isin(m["value"], (3, 4))]):
-        nxt = block_lines[block_lines > line]
-        starts.append((line, nxt[0] if nxt.size else line))
-        speeds.append(rpm[s_lines <= line][-1] if (s_lines <= line).any() else 0.0)
-    stops = m["line"][m["value"] == 1]
-    inside = ((stops[:, None] >= changes_arr[:, 0]) & (stops[:, None] <= changes_arr[:, 1])).any(1)
-    is_cut = np.isin(tp.kind, (1, 2, 3))
-    first_cut = int(tp.line[is_cut][0]) if is_cut.any() else 0
-    m30 = m["line"][np.isin(m["value"], (2, 30))]
-    lines = ProgramLines(
-        path.name,
-        first_cut,
-        int(m30[0]) if m30.size else int(tp.line.max(initial=0)) + 1,
-        changes_arr,
-        np.array(starts, np.int64).reshape(-1, 2),
-        np.array(speeds, float),
-        np.asarray(stops[~inside], np.int64),
-    )
-    return lines, tp
-
-
-def span_s(block_t_s: np.ndarray, block: np.ndarray, first: int, last: int) -> float:
-    """Time (s) from the first block event at or past line ``first`` to the first past line
-    ``last`` (``block_t_s``, ``block``: shape (n,), a run's events; NaN where either is
-    missing)."""
-    a, b = np.flatnonzero(block >= first), np.flatnonzero(block > last)
-    if not a.size or not b.size:
-        return np.nan
-    return float(block_t_s[b[0]] - block_t_s[a[0]])
-
-
-@dataclass(frozen=True)
-class RunTimes:
-    """What one valid run's timeline shows (s, gross: the motion of the spans included).
-
-    Parameters
-    ----------
-    log, program : str
-    rapid_plateau_mm_s, rapid_override_pct : float
-        ``Verdict.rapid_plateau_mm_s`` (NaN: no plateau) and ``Verdict.rapid_override_pct``
-        (logged, in force from the first cut on; NaN: not logged).
-    motion_s, duration_s : float
-        ``Verdict.motion_s``; the run's start to its end (:attr:`Run.duration_s`).
-    program_start_s, program_end_s : float
-        Start to the first block event; the M30 line's event to the end.
-    tool_change_s, spindle_start_s, optional_stop_s : numpy.ndarray
-        One span per tool change, spindle start, optional stop of the program (NaN where the
-        log shows no event for it), in :class:`ProgramLines` order.
-    first_line : int
-        The line of the run's first block event.
-    opening_s : float
-        The run's start to the first block event past the ``M6`` line of the program's first
-        tool change (:func:`_first_changes`); NaN where it has none.
-    """
-
-    log: str
-    program: str
-    rapid_plateau_mm_s: float
-    rapid_override_pct: float
-    motion_s: float
-    duration_s: float
-    program_start_s: float
-    program_end_s: float
-    tool_change_s: np.ndarray
-    spindle_start_s: np.ndarray
-    optional_stop_s: np.ndarray
-    first_line: int = 0
-    opening_s: float = np.nan
-
-
-def run_times(run: Run, lines: ProgramLines, verdict: Verdict) -> RunTimes:
-    """The :class:`RunTimes` of the valid ``run`` on the program ``lines``."""
-    t, b = run.block_t_s, run.block
-    m6 = _first_m6(lines)
-    past = np.flatnonzero(b > m6) if m6 else np.array([], int)
-    opening = float(t[past[0]] - run.start_s) if past.size else np.nan
-    return RunTimes(
-        run.log,
-        lines.file,
-        verdict.rapid_plateau_mm_s,
-        verdict.rapid_override_pct,
-        verdict.motion_s,
-        run.duration_s,
-        float(t[0] - run.start_s),
-        float(run.end_s - t[-1]),
-        np.array([span_s(t, b, a, z) for a, z in lines.tool_changes]),
-        np.array([span_s(t, b, a, z) for a, z in lines.spindle_starts]),
-        np.array([span_s(t, b, a, a) for a in lines.optional_stops]),
-        int(b[0]),
-        opening,
-    )
-
-
-def _first_changes(lines: ProgramLines) -> np.ndarray:
-    """Mask of ``lines.tool_changes`` before the first spindle start (shape (k,))."""
-    first = lines.spindle_starts[0, 0] if len(lines.spindle_starts) else np.inf
-    return lines.tool_changes[:, 1] < first
-
-
-def _first_m6(lines: ProgramLines) -> int:
-    """The ``M6`` line of the program's first tool change before any spindle start (0: none)."""
-    first = lines.tool_changes[_first_changes(lines)]
-    return int(first[0, 1]) if len(first) else 0
-
-
-def machine_runs(
-    machine_name: str,
-    log_paths: Sequence[str | Path] | None = None,
-    programs_dir: str | Path | None = None,
-) -> tuple[list[RunTimes], dict[str, tuple[ProgramLines, Toolpath]], pd.DataFrame]:
-    """The valid runs of one machine in the logs (default: the shipped ones whose name holds
-    ``machine_name``) against the programs of ``programs_dir`` (``*.NC``; default the shipped
-    ones, :func:`nctwin.paths.nist_dir`), and the rapid plateaus of all its runs.
-
-    Returns
-    -------
-    runs : list of RunTimes
-    programs : dict of str to (ProgramLines, Toolpath)
-        The programs the runs ran, by file name.
-    rapids : pandas.DataFrame
-        A row per run of a known program (valid or not) and logged rapid override it reaches a
-        plateau at: ``log``, ``program``, ``rapid_override_pct``, ``plateau_mm_s`` (the highest
-        steady feed on a single-axis G0 line while that override is in force).
-
-    Raises
-    ------
-    ValueError
-        A file that is no log (:func:`nctwin.mtconnect.read_log`'s one line), or no valid run
-        (the first run's reason: a program not in the folder is ``unknown_program``).
-    """
-    folder = nist_dir()
-    nc = folder / "nc" if programs_dir is None else Path(programs_dir)
-    texts = {p.name: p.read_text() for p in sorted(nc.glob("*.NC"))}
-    if log_paths is None:
-        log_paths = sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz"))
-    out, programs, why, rapids = [], {}, [], []
-    for path in map(Path, log_paths):
-        for run in runs(read_log(path)):
-            v = validate(run, texts)
-            if v.program is not None:
-                rapids += _plateaus(run, parse_program(v.program, texts[v.program]))
-            if not v.valid:
-                why.append(f"{path.name}: {v.reason} ({v.detail})")
-                continue
-            if v.program not in programs:
-                programs[v.program] = program_lines(nc / v.program)
-            out.append(run_times(run, programs[v.program][0], v))
-    if not out:
-        first = f"; {why[0]}" if why else ""
-        raise ValueError(f"no valid run of {machine_name} in {len(log_paths)} log(s){first}")
-    columns = ["log", "program", "rapid_override_pct", "plateau_mm_s"]
-    return out, programs, pd.DataFrame(rapids, columns=columns)
-
-
-def _plateaus(run: Run, program) -> list[tuple]:
-    """(log, program, override, plateau) per logged rapid override > 0 that ``run`` reaches a
-    single-axis G0 plateau at (:func:`machine_runs`)."""
-    t, line, v = steady_feed(run, program)
-    rapid = program.single_axis_rapid[line]
-    pct = run.rapid_override_pct.at(t[rapid])
-    return [(run.log, program.file, float(o), float(v[rapid][pct == o].max()))
-            for o in np.unique(pct[np.isfinite(pct) & (pct > 0)])]  # fmt: skip
-
 
 def axis_rapid_mm_s(rapids: pd.DataFrame | None, times: Sequence[RunTimes]) -> tuple[float, str]:
     """Each axis's rapid at 100 % (mm/s) and how it was read: the median of ``rapids``'
-    plateaus over their logged overrides (:func:`machine_runs`), else (no override logged) the
-    median plateau of ``times``, taken at 100 % (also where ``rapids`` is None).
+    plateaus over their logged overrides (:func:`nctwin.runtimes.machine_runs`), else (no
+    override logged) the median plateau of ``times``, taken at 100 % (also where ``rapids`` is
+    None).
 
     Raises
     ------
@@ -348,7 +127,7 @@ def run_overrides(
     return pct, np.where(known, source, "assumed")
 
 
-def _machine(name: str, rapid_mm_s: float) -> Machine:
+def base_machine(name: str, rapid_mm_s: float) -> Machine:
     """A machine of the identified axis rapid (every axis and the rapid feed at it) and a
     generic acceleration."""
     return Machine(
@@ -365,11 +144,6 @@ def _machine(name: str, rapid_mm_s: float) -> Machine:
 def _span_blocks(tp: Toolpath, spans: np.ndarray) -> list[np.ndarray]:
     """Per span (shape (k, 2), lines), the mask of ``tp``'s blocks within it."""
     return [(tp.line >= a) & (tp.line <= z) for a, z in spans]
-
-
-def _window(tp: Toolpath, lines: ProgramLines) -> np.ndarray:
-    """Mask of the blocks ``Verdict.motion_s`` times: the first cut's line to the M30's."""
-    return (tp.line >= lines.first_cut) & (tp.line < lines.m30)
 
 
 @dataclass(frozen=True)
@@ -420,12 +194,12 @@ class Calibration:
     runs: tuple
 
 
-def _sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
+def sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
     """The non-motion time ``seq`` gives the motion window of a program (s), or (``window``
     False) its lines before the window, where the first approach ends."""
     after = (lines.spindle_starts[:, 0] >= lines.first_cut) == window
     tc = (lines.tool_changes[:, 0] >= lines.first_cut) == window
-    first = _first_changes(lines)
+    first = first_changes(lines)
     spindle = sum(seq.spindle_s(rpm) for rpm in lines.spindle_rpm[after])
     stops = (lines.optional_stops >= lines.first_cut) == window
     changes = (tc & first).sum() * seq.tool_change_at_s(True)
@@ -457,9 +231,9 @@ def calibrate(
 ) -> Calibration:
     """Identify the rapid feed, the non-motion times and the motion models from ``times``.
 
-    The axis rapid is :func:`axis_rapid_mm_s` of ``rapids`` (:func:`machine_runs`; None: no
-    override logged), each run's rapid override :func:`run_overrides`. Non-motion times are
-    medians of the net spans (the module docstring), the spindle start a least-squares line in
+    The axis rapid is :func:`axis_rapid_mm_s` of ``rapids``
+    (:func:`nctwin.runtimes.machine_runs`; None: no override logged), each run's rapid override
+    :func:`run_overrides`. Non-motion times are medians of the net spans (the module docstring), the spindle start a least-squares line in
     the commanded speed where the runs command two speeds or more. The planner's three axis
     accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
     axis rapid), Lee et al.'s cutting time constant by :func:`nctwin.identify.fit_block_overlap`
@@ -470,7 +244,7 @@ def calibrate(
     """
     rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
     pct, source = run_overrides(times, rapid_mm_s)
-    machine = _machine(name, rapid_mm_s)
+    machine = base_machine(name, rapid_mm_s)
     net: dict[str, list] = {"tool_change": [], "spindle_start": [], "optional_stop": []}
     rpm: list[float] = []
     for r, o in zip(times, pct, strict=True):
@@ -499,7 +273,7 @@ def calibrate(
         v = med[key][np.isfinite(med[key])]
         fitted[key] = float(np.median(v)) if v.size else 0.0
         residuals[key] = v - fitted[key]
-    early = [r for r in times if r.first_line <= (_first_m6(programs[r.program][0]) or np.inf)]
+    early = [r for r in times if r.first_line <= (first_m6(programs[r.program][0]) or np.inf)]
     for key, runs_ in (("program_start", early or times), ("program_end", times)):
         v = np.array([getattr(r, f"{key}_s") for r in runs_])
         fitted[key] = float(np.median(v))
@@ -526,7 +300,7 @@ def calibrate(
         lines, tp = programs[file]
         measured = np.median([r.motion_s for r, k in zip(times, pct, strict=True)
                               if r.program == file and k == o])  # fmt: skip
-        pairs.append((tp.take(_window(tp, lines)), measured - _sequence_s(lines, seq)))
+        pairs.append((tp.take(motion_window(tp, lines)), measured - sequence_s(lines, seq)))
         shares.append(o / 100)
     planner = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
     pfit = fit_planner(pairs, machine, planner, fit_velocities=False, rapid_overrides=shares)
@@ -572,11 +346,11 @@ def predict_runs(
         for method in methods:
             key = (r.program, method, o)
             if key not in cache:
-                window = _window(tp, lines)
+                window = motion_window(tp, lines)
                 before = tp.line < lines.first_cut
-                motion = _motion_s(method, tp.take(window), cal, o) + _sequence_s(lines, seq)
+                motion = _motion_s(method, tp.take(window), cal, o) + sequence_s(lines, seq)
                 start = _motion_s(method, tp.take(before), cal, o) if before.any() else 0.0
-                start += _sequence_s(lines, seq, window=False)
+                start += sequence_s(lines, seq, window=False)
                 cache[key] = motion, motion + start + seq.program_start_s + seq.program_end_s
             motion, cycle = cache[key]
             rows.append({"log": r.log, "program": r.program, "method": method,

@@ -597,7 +597,8 @@ def _calibrate(args: argparse.Namespace) -> int:
 
 
 def _calibrate_logs(args: argparse.Namespace) -> int:
-    from .calibrate import calibrate, machine_runs, write_profile
+    from .calibrate import calibrate, write_profile
+    from .runtimes import machine_runs
 
     for log in args.logs:
         if not Path(log).is_file():

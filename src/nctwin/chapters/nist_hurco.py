@@ -46,17 +46,16 @@ import pandas as pd
 from ..calibrate import (
     LEE_PERIOD_S,
     Calibration,
-    _sequence_s,
-    _window,
     axis_rapid_mm_s,
     held_out_predictions,
-    machine_runs,
     predict_runs,
     run_overrides,
+    sequence_s,
 )
 from ..identify import identified_block_overlap
 from ..mtconnect import REASONS, nist_runs_table
 from ..report.tables import Claim, load_paper_table
+from ..runtimes import machine_runs, motion_window
 from . import nist_learned
 from .nist_learned import _nist_runs
 
@@ -94,7 +93,7 @@ LEARNED_METHODS = nist_learned.METHODS
 
 @functools.cache
 def _machine(name: str):
-    """:func:`nctwin.calibrate.machine_runs` of the shipped logs of ``name``."""
+    """:func:`nctwin.runtimes.machine_runs` of the shipped logs of ``name``."""
     return machine_runs(name)
 
 
@@ -206,7 +205,7 @@ def _acc_rows(name: str, cals: dict[str, Calibration]) -> pd.DataFrame:
     parts = []
     for file, cal in cals.items():
         lines, tp = programs[file]
-        lee = identified_block_overlap(tp.take(_window(tp, lines)), cal.planner_machine,
+        lee = identified_block_overlap(tp.take(motion_window(tp, lines)), cal.planner_machine,
                                        LEE_PERIOD_S)  # fmt: skip
         test = [r for r in times if r.program == file]
         pred = predict_runs(dataclasses.replace(cal, block_overlap=lee), test, programs,
@@ -227,7 +226,7 @@ def _learned_rows(name: str, analytic: pd.DataFrame, cals: dict[str, Calibration
         lines, _ = programs[r.program]
         cal = cals[r.program]
         ref = chosen.loc[(r.log, r.measured_s)]
-        motion = r.predicted_motion_s + _sequence_s(lines, cal.sequence)
+        motion = r.predicted_motion_s + sequence_s(lines, cal.sequence)
         outside = ref["predicted_cycle_s"] - ref["predicted_s"]
         rows.append({"log": r.log, "program": r.program, "method": r.method, "seed": r.seed,
                      "override_pct": r.override_pct, "override_source": r.override_source,

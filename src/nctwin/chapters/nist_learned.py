@@ -3,23 +3,23 @@ al. (2022)'s per-axis networks trained on the MTConnect logs of NIST's Hurco VMX
 (:mod:`nctwin.mtconnect`), each program held out in turn within its machine, the folds of
 :func:`nctwin.calibrate.leave_one_program_out`.
 
-**What a log resolves.** ``Block_Number`` is logged on change, so a short line may never show
-and an event may lag the line's start: the log times *spans*, never single lines. Over the
-motion window (:func:`nctwin.calibrate._window`, what ``Verdict.motion_s`` times), the span
-from the event of line :math:`a` to the event of the next observed line :math:`b` times the
-moves of lines :math:`a \ldots b-1` (:func:`block_spans`). Each move of a span gets the span's
-average feed, its moves' length over its time (:func:`span_targets`): Chien's target, with its
-log time ratio :math:`\ln(F_k \tilde t_k / l_k)` as :func:`nctwin.estimate.learned.move_data`
-forms it (:math:`F_k` the feed feature, :math:`\tilde t_k` the move's share of the span's time
-at the span's average feed). A span that holds a line of non-motion time (:func:`non_motion_lines`:
-a tool change, a spindle start, an optional stop, a dwell, an M-code the control waits at) or
-whose time is not positive is left NaN, out of the loss. Sun's per-axis target
-(:func:`axis_targets`) is the ``Feed_Rate`` record nearest in time to the move's interval (the
-span's time laid over its moves in proportion to their length) among the records within the
-move's span, times the move's direction; NaN where the span holds no record (or is left NaN
-above). The moves and features are :func:`~nctwin.estimate.learned.move_data`'s (arcs cut into
-chords by :func:`~nctwin.estimate.learned.model_blocks`) on the fold's machine
-(:func:`nctwin.calibrate._machine` at the fold's axis rapid, its rapids at the run's rapid
+**What a log resolves** (:mod:`nctwin.chapters.nist_targets`). ``Block_Number`` is logged on
+change, so a short line may never show and an event may lag the line's start: the log times
+*spans*, never single lines. Over the motion window (:func:`nctwin.runtimes.motion_window`, what
+``Verdict.motion_s`` times), the span from the event of line :math:`a` to the event of the next
+observed line :math:`b` times the moves of lines :math:`a \ldots b-1`. Each move of a span gets
+the span's average feed, its moves' length over its time: Chien's target, with its log time
+ratio :math:`\ln(F_k \tilde t_k / l_k)` as :func:`nctwin.estimate.learned.move_data` forms it
+(:math:`F_k` the feed feature, :math:`\tilde t_k` the move's share of the span's time at the
+span's average feed). A span that holds a line of non-motion time (a tool change, a spindle
+start, an optional stop, a dwell, an M-code the control waits at) or whose time is not positive
+is left NaN, out of the loss. Sun's per-axis target is the ``Feed_Rate`` record nearest in time
+to the move's interval (the span's time laid over its moves in proportion to their length) among
+the records within the move's span, times the move's direction; NaN where the span holds no
+record (or is left NaN above). The moves and features are
+:func:`~nctwin.estimate.learned.move_data`'s (arcs cut into chords by
+:func:`~nctwin.estimate.learned.model_blocks`) on the fold's machine
+(:func:`nctwin.calibrate.base_machine` at the fold's axis rapid, its rapids at the run's rapid
 override, :func:`nctwin.identify.at_rapid_override`) with :data:`CONTROL`.
 
 **One** :class:`~nctwin.estimate.learned.MoveData` **per program and rapid override**
@@ -52,17 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..calibrate import (
-    ProgramLines,
-    RunTimes,
-    _machine,
-    _plateaus,
-    _window,
-    axis_rapid_mm_s,
-    program_lines,
-    run_overrides,
-    run_times,
-)
+from ..calibrate import axis_rapid_mm_s, base_machine, run_overrides
 from ..controls import PlannerControl
 from ..estimate.learned import (
     BILSTM_CONFIG,
@@ -75,10 +65,11 @@ from ..estimate.learned import (
 from ..identify import at_rapid_override
 from ..learn.train import TrainConfig, Trained, _split, fit
 from ..methods import sun2022
-from ..mtconnect import Run, Track, parse_program, read_log, runs, validate
-from ..paths import nist_dir
+from ..mtconnect import Run
 from ..runner import run_tasks
-from ..toolpath import MotionKind, Toolpath
+from ..runtimes import ProgramLines, RunTimes, logged_runs, motion_window
+from ..toolpath import Toolpath
+from .nist_targets import axis_targets, block_spans, non_motion_lines, span_targets
 
 __all__ = [
     "CONTROL",
@@ -87,22 +78,16 @@ __all__ = [
     "MAX_VAL_ROWS",
     "METHODS",
     "MIN_PIECE_MOVES",
-    "WAIT_M_CODES",
     "Fold",
     "HeldOutRun",
     "LoggedRun",
-    "Spans",
-    "axis_targets",
-    "block_spans",
     "configs",
     "fold_data",
     "learned_predictions",
     "move_feeds",
-    "non_motion_lines",
     "program_move_data",
     "run_move_data",
     "sample_windows",
-    "span_targets",
     "tool_sections",
     "train_folds",
     "training_sets",
@@ -114,205 +99,11 @@ CONTROL = PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
 #: Tool sections shorter than this many moves join the next (:func:`tool_sections`).
 MIN_PIECE_MOVES = 256
 
-#: M-codes the control waits at: program stop, optional stop, spindle start (CW, CCW) and stop,
-#: tool change, spindle orientation. Coolant (M7-M9) moves on at once.
-WAIT_M_CODES = (0, 1, 3, 4, 5, 6, 19)
-
-
-@dataclass(frozen=True)
-class Spans:
-    """The spans a run's ``Block_Number`` events time over a motion window.
-
-    Parameters
-    ----------
-    first_line, end_line : numpy.ndarray of int64, shape (S,)
-        Span ``s`` times the lines ``first_line[s] .. end_line[s] - 1``: from the event of
-        ``first_line[s]`` to the event of the next observed line ``end_line[s]``.
-    t0_s, t1_s : numpy.ndarray, shape (S,)
-        The times of those two events (s).
-    """
-
-    first_line: np.ndarray
-    end_line: np.ndarray
-    t0_s: np.ndarray
-    t1_s: np.ndarray
-
-    @property
-    def time_s(self) -> np.ndarray:
-        """The time of each span (s), shape (S,)."""
-        return self.t1_s - self.t0_s
-
-
-def block_spans(block_t_s: np.ndarray, block: np.ndarray, first_cut: int, m30: int) -> Spans:
-    """The spans between consecutive block events over the motion window.
-
-    Parameters
-    ----------
-    block_t_s, block : numpy.ndarray, shape (n,)
-        A run's ``Block_Number`` events (:attr:`nctwin.mtconnect.Run.block_t_s`,
-        :attr:`~nctwin.mtconnect.Run.block`).
-    first_cut, m30 : int
-        The window's first line and its M30 line (:class:`~nctwin.calibrate.ProgramLines`).
-
-    Returns
-    -------
-    Spans
-        From the first event at or past ``first_cut`` (where ``Verdict.motion_s`` starts) to
-        the first event at or past ``m30`` (where it ends); events of a line not past the one
-        before (none in a valid run) are skipped.
-    """
-    t, b = np.asarray(block_t_s, float), np.asarray(block, np.int64)
-    keep = b >= first_cut
-    t, b = t[keep], b[keep]
-    end = np.flatnonzero(b >= m30)
-    if end.size:
-        t, b = t[: end[0] + 1], b[: end[0] + 1]
-    ahead = np.r_[True, b[1:] > np.maximum.accumulate(b)[:-1]] if b.size else b.astype(bool)
-    t, b = t[ahead], b[ahead]
-    return Spans(b[:-1], b[1:], t[:-1], t[1:])
-
-
-def non_motion_lines(lines: ProgramLines, tp: Toolpath) -> np.ndarray:
-    """The lines of a program that carry time no move accounts for.
-
-    Parameters
-    ----------
-    lines : ProgramLines
-        The program's tool changes (from the ``G28`` line to the ``M6`` line), spindle starts
-        (the ``M3``/``M4`` line and the next line with a block) and optional stops.
-    tp : Toolpath
-        The whole program: its dwells' lines and the lines of :data:`WAIT_M_CODES`.
-
-    Returns
-    -------
-    numpy.ndarray of int64, shape (k,)
-        Sorted, unique 1-based lines.
-    """
-    spans = np.concatenate([lines.tool_changes, lines.spindle_starts]).reshape(-1, 2)
-    ranged = [np.arange(a, z + 1) for a, z in spans]
-    ev = tp.events
-    waits = ev["line"][(ev["word"] == "M") & np.isin(ev["value"], WAIT_M_CODES)]
-    dwells = tp.line[tp.kind == MotionKind.DWELL]
-    parts = [*ranged, lines.optional_stops, waits, dwells]
-    return np.unique(np.concatenate([np.asarray(p, np.int64).ravel() for p in parts]))
-
-
-def span_targets(
-    move_line: np.ndarray,
-    length_mm: np.ndarray,
-    feed_mm_s: np.ndarray,
-    spans: Spans,
-    non_motion: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    r"""Chien's per-move targets from the spans: the span's average feed and the log time ratio.
-
-    Parameters
-    ----------
-    move_line : numpy.ndarray of int64, shape (M,)
-        The program line of each move, in program order.
-    length_mm, feed_mm_s : numpy.ndarray, shape (M,)
-        Each move's length :math:`l_k` and feed feature :math:`F_k`.
-    spans : Spans
-        :func:`block_spans` (S spans).
-    non_motion : numpy.ndarray of int64, shape (k,)
-        :func:`non_motion_lines`.
-
-    Returns
-    -------
-    targets : numpy.ndarray, shape (M, 2)
-        The average feed :math:`\bar f` (mm/s) of the move's span, its length over its time,
-        and :math:`\ln (F_k \tilde t_k / l_k) = \ln (F_k / \bar f)` (the move's time at the
-        span's average feed); both NaN for a move in no span, in a span that holds a line of
-        ``non_motion`` or whose time is not positive.
-    span : numpy.ndarray of int64, shape (M,)
-        The span of each move (-1: none, or a span left NaN).
-    move_t_s : numpy.ndarray, shape (M, 2)
-        The start and end time of each move, its span's time laid over the span's moves in
-        proportion to their length (NaN where ``span`` is -1).
-    """
-    move_line = np.asarray(move_line, np.int64)
-    length = np.asarray(length_mm, float)
-    k = np.searchsorted(spans.first_line, move_line, side="right") - 1
-    inside = k >= 0
-    inside[inside] = move_line[inside] < spans.end_line[k[inside]]
-    # spans that hold a non-motion line, or no time
-    held = np.searchsorted(non_motion, spans.first_line, side="left")
-    blocked = (held < len(non_motion)) & (
-        np.r_[non_motion, np.iinfo(np.int64).max][held] < spans.end_line
-    )
-    ok_span = ~blocked & (spans.time_s > 0)
-    span = np.where(inside, k, -1)
-    span[inside] = np.where(ok_span[k[inside]], k[inside], -1)
-    use = span >= 0
-    span_len = np.bincount(span[use], weights=length[use], minlength=len(spans.first_line))
-    targets = np.full((len(move_line), 2), np.nan)
-    move_t = np.full((len(move_line), 2), np.nan)
-    if use.any():
-        s = span[use]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            avg = span_len[s] / spans.time_s[s]
-            targets[use, 0] = np.where(avg > 0, avg, np.nan)
-            targets[use, 1] = np.log(np.asarray(feed_mm_s, float)[use] / targets[use, 0])
-        # cumulative length within each span (moves of a span are consecutive)
-        cum = np.cumsum(length[use])
-        first = np.r_[True, s[1:] != s[:-1]]
-        base = np.maximum.accumulate(np.where(first, cum - length[use], 0.0))
-        end = cum - base
-        share0, share1 = (end - length[use]) / span_len[s], end / span_len[s]
-        dt = spans.time_s[s]
-        move_t[use, 0] = spans.t0_s[s] + share0 * dt
-        move_t[use, 1] = spans.t0_s[s] + share1 * dt
-    return targets, span, move_t
-
-
-def axis_targets(
-    directions: np.ndarray, span: np.ndarray, move_t_s: np.ndarray, spans: Spans, feed: Track
-) -> np.ndarray:
-    """Sun's per-axis targets: the logged feed record nearest each move, times its direction.
-
-    Parameters
-    ----------
-    directions : numpy.ndarray, shape (M, 3)
-        Each move's unit direction.
-    span, move_t_s : numpy.ndarray, shapes (M,) and (M, 2)
-        :func:`span_targets`' span of each move and its time interval.
-    spans : Spans
-    feed : Track
-        The run's ``Feed_Rate`` records (:attr:`nctwin.mtconnect.Run.feed_mm_s`, mm/s).
-
-    Returns
-    -------
-    numpy.ndarray, shape (M, 3)
-        The record nearest in time to the move's interval (one inside it where any is: the
-        one nearest its middle) among the records within the move's span, times the move's
-        direction; NaN where the span holds no record or ``span`` is -1.
-    """
-    span = np.asarray(span, np.int64)
-    out = np.full((len(span), 3), np.nan)
-    use = span >= 0
-    if not use.any() or not feed.t_s.size:
-        return out
-    s = span[use]
-    mid = move_t_s[use].mean(axis=1)
-    lo = np.searchsorted(feed.t_s, spans.t0_s[s], side="left")  # first record in the span
-    hi = np.searchsorted(feed.t_s, spans.t1_s[s], side="right") - 1  # last record in it
-    j = np.clip(np.searchsorted(feed.t_s, mid), lo, np.maximum(hi, lo))  # first at/after mid
-    before = np.clip(j - 1, lo, None)
-    pick = np.where(
-        np.abs(feed.t_s[np.minimum(before, len(feed.t_s) - 1)] - mid)
-        <= np.abs(feed.t_s[np.minimum(j, len(feed.t_s) - 1)] - mid),
-        before,
-        j,
-    )
-    value = np.where(hi >= lo, feed.value[np.minimum(pick, len(feed.t_s) - 1)], np.nan)
-    out[use] = value[:, None] * np.asarray(directions, float)[use]
-    return out
-
 
 @dataclass(frozen=True, eq=False)
 class LoggedRun:
     """A valid run of a machine's logs: the :class:`~nctwin.mtconnect.Run` (its events) and its
-    :class:`~nctwin.calibrate.RunTimes` (what :func:`nctwin.calibrate.machine_runs` returns)."""
+    :class:`~nctwin.runtimes.RunTimes` (what :func:`nctwin.runtimes.machine_runs` returns)."""
 
     run: Run
     times: RunTimes
@@ -320,24 +111,9 @@ class LoggedRun:
 
 @functools.cache
 def _nist_runs(machine_name: str) -> tuple[tuple[LoggedRun, ...], dict, pd.DataFrame]:
-    """:func:`nctwin.calibrate.machine_runs` of the shipped logs, the runs' events kept."""
-    folder = nist_dir()
-    texts = {p.name: p.read_text() for p in sorted((folder / "nc").glob("*.NC"))}
-    out, programs, rapids = [], {}, []
-    for path in sorted((folder / "logs").glob(f"*{machine_name}*.txt.gz")):
-        for run in runs(read_log(path)):
-            v = validate(run, texts)
-            if v.program is not None:
-                rapids += _plateaus(run, parse_program(v.program, texts[v.program]))
-            if not v.valid:
-                continue
-            if v.program not in programs:
-                programs[v.program] = program_lines(folder / "nc" / v.program)
-            out.append(LoggedRun(run, run_times(run, programs[v.program][0], v)))
-    if not out:
-        raise ValueError(f"no valid run of {machine_name} in the shipped logs")
-    columns = ["log", "program", "rapid_override_pct", "plateau_mm_s"]
-    return tuple(out), programs, pd.DataFrame(rapids, columns=columns)
+    """:func:`nctwin.runtimes.logged_runs` of the shipped logs."""
+    pairs, programs, rapids = logged_runs(machine_name)
+    return tuple(LoggedRun(run, times) for run, times in pairs), programs, rapids
 
 
 def run_move_data(
@@ -350,8 +126,8 @@ def run_move_data(
     run : Run
         A valid run of the program.
     lines, tp : ProgramLines, Toolpath
-        The program (:func:`nctwin.calibrate.program_lines`); only the motion window's blocks,
-        ``tp.take(_window(tp, lines))``, are moves.
+        The program (:func:`nctwin.runtimes.program_lines`); only the motion window's blocks,
+        ``tp.take(motion_window(tp, lines))``, are moves.
     machine : Machine
         The machine at the run's rapid override (features: :data:`CONTROL`).
     name : str, optional
@@ -365,7 +141,7 @@ def run_move_data(
         ``measured_s`` the window's time from the first to the last span event (the run's
         ``Verdict.motion_s``).
     """
-    data = move_data(name or run.log, tp.take(_window(tp, lines)), machine, CONTROL)
+    data = move_data(name or run.log, tp.take(motion_window(tp, lines)), machine, CONTROL)
     spans = block_spans(run.block_t_s, run.block, lines.first_cut, lines.m30)
     y, span, move_t = span_targets(
         data.moves.line, data.features[:, 1], data.features[:, 0], spans,
@@ -527,7 +303,7 @@ def fold_data(machine_name: str, program: str) -> Fold:
     known = source != "assumed"
     if not known.any():
         raise ValueError(f"no run of {machine_name} but {program}'s has a known rapid override")
-    machine = _machine(machine_name, rapid_mm_s)
+    machine = base_machine(machine_name, rapid_mm_s)
     groups: dict[tuple[str, float], list[Run]] = {}
     for r, o, k in zip(train, pct, known, strict=True):
         if not k:
