@@ -234,8 +234,8 @@ def calibrate(
     The axis rapid is :func:`axis_rapid_mm_s` of ``rapids``
     (:func:`nctwin.runtimes.machine_runs`; None: no override logged), each run's rapid override
     :func:`run_overrides`. Non-motion times are medians of the net spans (the module docstring),
-    the spindle start a least-squares line in the commanded speed where the runs command two speeds or more. The planner's three axis
-    accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
+    the spindle start a least-squares line in the commanded speed where the runs command two
+    speeds or more. The planner's three axis accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
     axis rapid), Lee et al.'s cutting time constant by :func:`nctwin.identify.fit_block_overlap`
     (period :data:`LEE_PERIOD_S`, on the planner's machine), the FIR kernel by
     :func:`nctwin.identify.fit_fir` on :data:`CALIBRATE_FIR_GRID`, each on the median motion
