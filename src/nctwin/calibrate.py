@@ -235,12 +235,14 @@ def calibrate(
     (:func:`nctwin.runtimes.machine_runs`; None: no override logged), each run's rapid override
     :func:`run_overrides`. Non-motion times are medians of the net spans (the module docstring),
     the spindle start a least-squares line in the commanded speed where the runs command two
-    speeds or more. The planner's three axis accelerations are fitted by :func:`nctwin.identify.fit_planner` (the velocities held at the
-    axis rapid), Lee et al.'s cutting time constant by :func:`nctwin.identify.fit_block_overlap`
-    (period :data:`LEE_PERIOD_S`, on the planner's machine), the FIR kernel by
+    speeds or more. The planner's three axis accelerations are fitted by
+    :func:`nctwin.identify.fit_planner` (the velocities held at the axis rapid), Lee et al.'s
+    cutting time constant by :func:`nctwin.identify.fit_block_overlap` (period
+    :data:`LEE_PERIOD_S`, on the planner's machine), the FIR kernel by
     :func:`nctwin.identify.fit_fir` on :data:`CALIBRATE_FIR_GRID`, each on the median motion
     time (minus the non-motion times) of each program and rapid override, runs of an assumed
-    override left out; the best method is the one of least mean absolute error on these same runs.
+    override left out; the best method is the one of least mean absolute error on these same
+    runs.
     """
     rapid_mm_s, rapid_source = axis_rapid_mm_s(rapids, times)
     pct, source = run_overrides(times, rapid_mm_s)
