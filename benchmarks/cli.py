@@ -51,11 +51,11 @@ def long_program(passes: int = PASSES) -> str:
     return "\n".join(out) + "\n"
 
 
-def measure(args: list[str]) -> tuple[float, float, float]:
-    """Shortest wall time (s) and CPU time (s) of ``nctwin *args`` over :data:`REPEAT` runs,
-    and its peak resident memory (GB)."""
+def measure(args: list[str], repeat: int = REPEAT) -> tuple[float, float, float]:
+    """Shortest wall time (s) and CPU time (s) of ``nctwin *args`` over ``repeat`` runs, and
+    its peak resident memory (GB)."""
     times, cpu, peaks = [], [], []
-    for _ in range(REPEAT):
+    for _ in range(repeat):
         cmd = [sys.executable, "-c", _MEASURE, sys.executable, "-m", "nctwin.cli", *args]
         out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.split()
         times.append(float(out[0]))
