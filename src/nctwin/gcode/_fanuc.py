@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..machine import DIALECTS
 from ._errors import _Errors
 from ._lexer import _L
 from ._modal import _MOTION, _fmt_g
 
-#: Dialects of :func:`nctwin.gcode.parse`: LinuxCNC 2.9's RS274/NGC, or a Fanuc milling control's.
-DIALECTS = ("rs274ngc", "fanuc")
 _TAPPING = (740, 840)
 _NOT_READ_M = {98.0: "subprogram call", 99.0: "subprogram return"}
 
