@@ -33,8 +33,9 @@ def _fanuc_words(code, value, line, has, G, motion, cycle_line, errors: _Errors)
     """Check the fanuc dialect's own words; return which lines run a rigid tapping cycle.
 
     An M29 makes the first canned-cycle line at or after it rigid tapping, and the lines of
-    that cycle after it until another motion code (Fanuc cancels rigid tapping with G80 or
-    another motion code); a G80 between the M29 and the cycle cancels it. A cycle other than
+    that cycle after it until another motion code (the sources name G80 as what cancels rigid
+    tapping; another motion code is taken to end it too); a G80 between the M29 and the cycle
+    cancels it. A cycle other than
     G84 or G74 after an M29 is refused, naming the M29's line. Rigid tapping moves as floating
     tapping does; only the reader's checks of the spindle's turning are left out (the control
     turns the spindle itself, synchronised with the tapping axis).
