@@ -52,7 +52,9 @@ for the rest.
 Programs are read by nctwin's own fast reader; what only LinuxCNC's interpreter
 reads (O-word subroutines and loops, #parameters and expressions, cutter
 compensation) goes to that interpreter where it is installed (make linuxcnc):
---reader chooses. The output says which reader read the program."""
+--reader chooses. The output says which reader read the program. On a machine
+whose profile has dialect = "fanuc", programs are read as a Fanuc milling control
+reads them (M29 rigid tapping, G76 fine boring, P in ms), by nctwin's reader."""
 
 EXAMPLES = """\
 examples:
@@ -290,9 +292,9 @@ def _program_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--dwell-p-unit",
-        default="s",
         choices=("s", "ms"),
-        help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc; native reader only)",
+        help="unit of P in G4: s (RS274/NGC, LinuxCNC) or ms (Fanuc; native reader only); "
+        'default: s, ms on a machine whose profile has dialect = "fanuc"',
     )
     p.add_argument(
         "--reader",
@@ -370,6 +372,8 @@ def _load(args: argparse.Namespace, stage: _Stages) -> tuple[Profile, Toolpath, 
     text, source = _read_program(args.program)
     stage("parse")
     kwargs = {"source": source, "units": args.input_units, "dwell_p_unit": args.dwell_p_unit}
+    if profile.dialect != "rs274ngc":  # (the default keeps LinuxCNC's interpreter in reach)
+        kwargs["dialect"] = profile.dialect
     if args.program != "-" and args.reader != "native":
         kwargs["folder"] = Path(args.program).resolve().parent
     if args.tool_table is not None:

@@ -4,9 +4,11 @@ estimate to trust, in one file (``data/machines/*.toml``).
 A profile's file has one ``[machine]`` table (:class:`Machine`: axis limits, rapid and maximum
 feed), one ``[control.<kind>]`` table per control model it is described for
 (:data:`nctwin.controls.CONTROLS`: ``fir``, ``accdec``, ``fanuc``, ``planner``,
-``sequence``), and two
-top-level keys: ``default_method``, the method ``nctwin estimate`` uses when none is named, and
-``recordings``, the shipped recordings of this machine the learned methods train on (if any).
+``sequence``), and three
+top-level keys: ``default_method``, the method ``nctwin estimate`` uses when none is named,
+``recordings``, the shipped recordings of this machine the learned methods train on (if any),
+and ``dialect``, the G-code dialect ``nctwin estimate`` and ``nctwin simulate`` read its
+programs in (:data:`DIALECTS`; default ``"rs274ngc"``).
 No key is written twice, and an unknown or misspelt key is refused with the file, the table and
 the key. Values fitted to recordings are written into the file by a command
 (:func:`write_control`), never looked up elsewhere at run time, so a copy of a profile under
@@ -31,7 +33,7 @@ from dataclasses import MISSING, dataclass, fields
 from datetime import date
 from pathlib import Path
 
-from .checks import check_number, check_xyz
+from .checks import check_choice, check_number, check_xyz
 from .controls import (
     CONTROLS,
     AccDecControl,
@@ -45,6 +47,7 @@ from .paths import data_dir
 
 __all__ = [
     "DEFAULT_MACHINE",
+    "DIALECTS",
     "METHOD_CONTROLS",
     "Machine",
     "Profile",
@@ -57,6 +60,10 @@ __all__ = [
 
 #: Profile used when none is named.
 DEFAULT_MACHINE = "generic_mill"
+
+#: G-code dialects (a profile's ``dialect``, :func:`nctwin.gcode.parse`'s ``dialect``): LinuxCNC
+#: 2.9's RS274/NGC, or a Fanuc milling control's.
+DIALECTS = ("rs274ngc", "fanuc")
 
 #: The control model each estimate method runs on (None: the machine alone).
 METHOD_CONTROLS: dict[str, str | None] = {
@@ -134,6 +141,9 @@ class Profile:
     recordings : str or None
         Name of the shipped recordings of this machine (:mod:`nctwin.recordings`) the learned
         methods train on; None: the learned methods do not exist for it.
+    dialect : {"rs274ngc", "fanuc"}
+        The G-code dialect ``nctwin estimate`` and ``nctwin simulate`` read the machine's
+        programs in (:func:`nctwin.gcode.parse`'s ``dialect``).
     """
 
     machine: Machine
@@ -144,6 +154,7 @@ class Profile:
     sequence: SequenceControl | None = None
     default_method: str = "cam"
     recordings: str | None = None
+    dialect: str = "rs274ngc"
 
     def __post_init__(self) -> None:
         if not isinstance(self.machine, Machine):
@@ -167,6 +178,7 @@ class Profile:
                 f"recordings = {self.recordings!r} is out of range: allowed a shipped "
                 "recordings' name"
             )
+        check_choice("dialect", self.dialect, DIALECTS)
 
     @property
     def name(self) -> str:
@@ -225,7 +237,7 @@ class Profile:
         """
         p = Path(path)
         data = _read_toml(p)
-        top = {"machine", "control", "default_method", "recordings"}
+        top = {"machine", "control", "default_method", "recordings", "dialect"}
         _refuse_unknown(p, "", data, top)
         machine_table = data.get("machine")
         if not isinstance(machine_table, dict):
@@ -247,6 +259,7 @@ class Profile:
                 **controls,
                 default_method=data.get("default_method", "cam"),
                 recordings=data.get("recordings"),
+                dialect=data.get("dialect", "rs274ngc"),
             )
         except ValueError as exc:
             raise ValueError(f"{p}: {exc}") from None

@@ -60,6 +60,32 @@ compensation, ...) raises :class:`GCodeError` with ``<construct> needs LinuxCNC'
 run make linuxcnc``; rotary axes and codes LinuxCNC lacks are refused too. Every error of a file
 is reported, up to 20, one ``file:line: reason`` line each.
 
+Dialects
+--------
+``dialect="rs274ngc"`` (default) reads the program as above, LinuxCNC's language.
+``dialect="fanuc"`` (native reader only) reads a Fanuc milling control's, as a Fanuc-style CAM
+post (a Hurco in ISO mode, a Fanuc 0i) writes it:
+
+* P in G4 and in canned cycles is in milliseconds (an explicit ``dwell_p_unit`` wins).
+* ``M29 S..`` before a G84 or G74 selects rigid tapping for that cycle, until G80 or another
+  motion code. Rigid tapping moves as floating tapping does (feed in, dwell P, feed out to R or
+  the initial level); the spindle, which the control then turns itself, need not be turning
+  before. A canned cycle other than G84/G74 after an M29 is refused, naming the M29's line.
+* G76 is fine boring, not LinuxCNC's threading: per hole, rapids over it and to R, a feed to
+  the bottom, the dwell P, a rapid shift by Q (its sign ignored) along the plane's first axis
+  in its + direction (+X in G17), a rapid out to R (G99) or the initial level (G98), and a
+  rapid shift back (:mod:`nctwin.gcode._cycles` gives the sources). G98/G99 and L repeats as
+  in the other cycles.
+* Refused, one ``file:line: reason`` each, as codes this reader does not read as a Fanuc
+  control does: G87 (Fanuc's back boring shifts by Q), G92.1-G92.3, G90.1, G91.1, G5, G5.1,
+  G8, G52, G10, M98/M99 subprograms, K repeats of a canned cycle (write L); and whatever the
+  rs274ngc dialect leaves to LinuxCNC's interpreter, which reads RS274/NGC only.
+
+The reader makes geometry and dwells: the spindle's orientation, stops, restarts and reversals
+(M19 in G76, the reversal at the bottom of a tap) take no time here. G73 and G83 retract by
+LinuxCNC's 0.010 in, where a Fanuc control retracts by its parameters (No. 5114 and 5115 on a
+0i).
+
 Two readers
 -----------
 :func:`parse` and :func:`parse_file` take ``reader="auto"`` (default), ``"native"`` or
@@ -83,6 +109,7 @@ from ._cycles import G83_RAPID_DELTA_IN as G83_RAPID_DELTA_IN
 from ._dump import dump
 from ._errors import MAX_ERRORS as MAX_ERRORS
 from ._errors import GCodeError
+from ._fanuc import DIALECTS as DIALECTS
 from ._interp import LINUXCNC_TOOL_TABLE as LINUXCNC_TOOL_TABLE
 from ._interp import MAX_MOVES as MAX_MOVES
 from ._interp import TIMEOUT_BASE_S as TIMEOUT_BASE_S

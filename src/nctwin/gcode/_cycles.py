@@ -1,7 +1,21 @@
 """G92 offsets and canned cycles (G73, G74, G81-G89): the constructs that carry state from line
 to line in ways a cumulative sum cannot, interpreted one by one on the lines that hold them, as
 LinuxCNC 2.9 does (``convert_axis_offsets`` in interp_convert.cc, interp_cycles.cc); and the
-G28/G30 reference points under G92 offsets (``convert_home``)."""
+G28/G30 reference points under G92 offsets (``convert_home``).
+
+In the fanuc dialect, G76 is a milling control's fine boring cycle: at each hole a rapid over
+it and down to R (as G81), a feed to the bottom, the dwell P (if any), an oriented spindle stop,
+a rapid shift by Q along the plane's first axis (+X in G17: Fanuc's shift direction parameter,
+No. 5101 RD1/RD2 on a 0i, is taken as +), a rapid out to R (G99) or the initial level (G98) and
+a rapid shift back, after which the spindle turns again. The stop and restart take no time
+here. Sources: FANUC Series 15i/150i-MA Operator's Manual (Programming), p. 315 on
+www.cncmanuals.com (Q is the shift at the bottom of the hole, positive, its sign ignored,
+modal in the canned cycle, its direction a parameter); and the G76 format ``G76 X Y Z R Q P F
+K`` with Q the shift and P the dwell, the tool stopped oriented at the bottom, shifted and
+taken out by rapid, in a post on FANUC's canned cycles (blog.csdn.net/weixin_42153801/article/
+details/113069589). That the shifts are rapids is this reader's reading (the 15i manual feeds an I/J
+shift at F).
+"""
 
 from __future__ import annotations
 
@@ -46,6 +60,7 @@ class _Lines:
     retract_r: np.ndarray  # G99 (retract to R), else G98
     spindle: np.ndarray  # +1 clockwise, -1 counter-clockwise, 0 stopped
     p_scale: float
+    rigid: np.ndarray | None = None  # fanuc dialect: lines of rigid tapping (after an M29)
 
 
 class _LineError(Exception):
@@ -254,8 +269,10 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
     if r < bottom:
         raise _LineError(f"R less than {depth_letter} in {name}")
     p, q, ijk = sticky.p, sticky.q, sticky.ijk
-    if _DWELLS[c]:  # (tapping may go without P: it dwells the P kept, 0 at first)
-        if not (has["P"] or same or c in (740, 840)):
+    if c == 760:  # Fanuc fine boring: Q is the shift at the bottom, its sign ignored
+        q = abs(word("Q", sticky.q, "Q word (the shift at the bottom) missing with G76"))
+    if _DWELLS[c]:  # (tapping and G76 may go without P: they dwell the P kept, 0 at first)
+        if not (has["P"] or same or c in (740, 760, 840)):
             raise _LineError(f"dwell time P word missing with {name}")
         p = W["P"] * L.p_scale if has["P"] else sticky.p
     elif c in (730, 830):
@@ -267,6 +284,8 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
             word(x, v, f"{x} word missing with G87") for x, v in zip("IJK", ijk, strict=True)
         )
     spindle = L.spindle[k]
+    if L.rigid is not None and L.rigid[k]:  # rigid tapping: the control turns the spindle
+        spindle = 1 if c == 840 else -1
     if c in (860, 870, 880, 740, 840) and spindle == 0:
         raise _LineError(f"spindle not turning in {name}")
     if (c, spindle) in ((840, -1), (740, 1)):
@@ -315,6 +334,15 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
                 depth_now = depth_now - q
             go(feed, aa, bb, bottom)
             go(rapid, aa, bb, clear)
+        elif c == 760:  # Fanuc fine boring (see the module docstring)
+            go(feed, aa, bb, bottom)
+            if p > 0:
+                dwell(p)
+            if q > 0:  # the oriented stop (M19) takes no time here; the shift is a rapid
+                go(rapid, aa + q, bb, bottom)
+            go(rapid, aa + q, bb, clear)
+            if q > 0:  # shift back, then the spindle restarts (no time here either)
+                go(rapid, aa, bb, clear)
         elif c == 870:  # back boring, in and out off centre by I/J with the spindle oriented
             oa, ob = aa + ijk[a], bb + ijk[b]
             middle = ijk[nrm] + (bottom if L.incremental[k] else 0.0)

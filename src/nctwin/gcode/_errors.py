@@ -9,6 +9,9 @@ import numpy as np
 #: Errors listed in a :class:`GCodeError`'s message; the rest are counted.
 MAX_ERRORS = 20
 _NEEDS_LINUXCNC = "needs LinuxCNC's interpreter: run make linuxcnc"
+#: What replaces :data:`_NEEDS_LINUXCNC` in the fanuc dialect, where LinuxCNC's interpreter,
+#: which reads RS274/NGC only, cannot help.
+_NOT_FANUC = "is not supported in the fanuc dialect"
 
 
 class GCodeError(ValueError):
@@ -70,6 +73,7 @@ class _Errors:
     def __init__(self, raw_lines: list[str], line_starts: np.ndarray, source: str | None):
         self.raw_lines, self.line_starts, self.source = raw_lines, line_starts, source
         self.found: list[tuple[np.ndarray, np.ndarray, np.ndarray, object]] = []
+        self.fanuc = False  # the fanuc dialect: no reason sends the reader to LinuxCNC's
 
     def at_pos(self, pos: np.ndarray, reason) -> None:
         """Record ``reason`` (a string, or a function of the position) at text positions."""
@@ -104,6 +108,8 @@ class _Errors:
             i = int(line[k])
             if callable(reason):
                 reason = reason(int(keys[hit[k]]) if stage[k] == 0 else i)
+            if self.fanuc:
+                reason = reason.replace(_NEEDS_LINUXCNC, _NOT_FANUC)
             text = self.raw_lines[i] if i < len(self.raw_lines) else ""
             errors.append(GCodeError(i + 1, text, reason, self.source))
         e = errors[0]

@@ -59,11 +59,35 @@ def _code_set(*codes: int) -> np.ndarray:
     return table
 
 
-_IS_CYCLE, _IS_G92, _IS_HOME = _code_set(*_CYCLES), _code_set(*_G92S), _code_set(*_HOMES)
-_IS_ARC, _PECKS = _code_set(20, 30), _code_set(730, 830)
-_DWELLS = _code_set(740, 820, 840, 860, 880, 890)  # cycles with a P dwell
+# G76 (760) is a cycle only in the fanuc dialect: fine boring, which dwells P and shifts by Q (the
+# rs274ngc table below does not know it, so no line's motion is 760 there)
+_IS_CYCLE, _IS_G92 = _code_set(*_CYCLES, 760), _code_set(*_G92S)
+_IS_HOME, _IS_ARC = _code_set(*_HOMES), _code_set(20, 30)
+_PECKS, _Q_FANUC = _code_set(730, 830), _code_set(730, 760, 830)  # cycles with a Q word
+_DWELLS = _code_set(740, 760, 820, 840, 860, 880, 890)  # cycles with a P dwell
 _G_CODES = np.array(sorted(_G_GROUP), dtype=np.int64)
 _G_GROUPS = np.array([_G_GROUP[c] for c in _G_CODES], dtype=np.int64)
+#: Codes the rs274ngc table reads that a Fanuc milling control reads otherwise, or lacks: refused
+#: in the fanuc dialect, with what they are there.
+_G_NOT_FANUC = {
+    870: "back boring, which a Fanuc control runs with a Q shift and an oriented spindle stop",
+    921: "workpiece coordinate system preset on a Fanuc control",
+    922: "a LinuxCNC offset code",
+    923: "a LinuxCNC offset code",
+    901: "absolute arc centres, a LinuxCNC code",
+    911: "a LinuxCNC code; on a Fanuc control, the maximum incremental amount check",
+}
+#: What codes LinuxCNC reads otherwise are on a Fanuc milling control (refused there too).
+_G_FANUC_NAMES = {
+    50: "high-speed cycle machining",
+    51: "AI contour control",
+    80: "look-ahead control",
+    520: "local coordinate system",
+    100: "data setting",
+}
+_FANUC_GROUP = {c: g for c, g in _G_GROUP.items() if c not in _G_NOT_FANUC} | {760: _MOTION}
+_G_CODES_FANUC = np.array(sorted(_FANUC_GROUP), dtype=np.int64)
+_G_GROUPS_FANUC = np.array([_FANUC_GROUP[c] for c in _G_CODES_FANUC], dtype=np.int64)
 #: Codes LinuxCNC reads and this reader does not: what they are.
 _G_LINUXCNC = {
     **dict.fromkeys((410, 411, 420, 421), "cutter compensation"),

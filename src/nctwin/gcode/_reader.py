@@ -19,7 +19,8 @@ from ..toolpath import (
     arc_sweep,
 )
 from ._cycles import _Lines, _special_positions
-from ._errors import _NEEDS_LINUXCNC, GCodeError, _Errors, _point_mm
+from ._errors import _NEEDS_LINUXCNC, _NOT_FANUC, GCodeError, _Errors, _point_mm
+from ._fanuc import _fanuc_words, check_dialect
 from ._lexer import _L, _LETTERS, _clean, _lex
 from ._modal import (
     _ARCDIST,
@@ -27,9 +28,13 @@ from ._modal import (
     _DWELLS,
     _FEEDMODE,
     _G_CODES,
+    _G_CODES_FANUC,
+    _G_FANUC_NAMES,
     _G_FOREIGN,
     _G_GROUPS,
+    _G_GROUPS_FANUC,
     _G_LINUXCNC,
+    _G_NOT_FANUC,
     _GROUP_NAMES,
     _IS_ARC,
     _IS_CYCLE,
@@ -41,6 +46,7 @@ from ._modal import (
     _PATH,
     _PECKS,
     _PLANE,
+    _Q_FANUC,
     _RETRACT,
     _ROW,
     _SINGLE,
@@ -61,7 +67,8 @@ def parse(
     *,
     source: str | None = None,
     units: str = "mm",
-    dwell_p_unit: str = "s",
+    dwell_p_unit: str | None = None,
+    dialect: str = "rs274ngc",
     block_delete: bool = False,
     start_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     g28_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
@@ -79,9 +86,14 @@ def parse(
         File name used in error messages.
     units : {"mm", "inch"}
         Units in force before the program's own G20/G21.
-    dwell_p_unit : {"s", "ms"}
+    dwell_p_unit : {"s", "ms"}, optional
         Unit of P in G4 and in the dwells of canned cycles: seconds (RS274/NGC, LinuxCNC) or
-        milliseconds (Fanuc).
+        milliseconds (Fanuc). Default: the dialect's, ``"s"`` for ``"rs274ngc"`` and ``"ms"``
+        for ``"fanuc"``; one given wins over the dialect's.
+    dialect : {"rs274ngc", "fanuc"}
+        The language of the program: LinuxCNC 2.9's RS274/NGC (default), or a Fanuc milling
+        control's (M29 rigid tapping, G76 fine boring, P in milliseconds; see the package's
+        docstring).
     block_delete : bool
         Whether the block-delete switch is on (lines starting with ``/`` are skipped).
     start_mm : tuple of 3 floats
@@ -111,6 +123,9 @@ def parse(
     """
     if units not in ("mm", "inch"):
         raise ValueError(f"units must be 'mm' or 'inch', got {units!r}")
+    check_dialect(dialect)
+    if dwell_p_unit is None:
+        dwell_p_unit = "ms" if dialect == "fanuc" else "s"
     if dwell_p_unit not in ("s", "ms"):
         raise ValueError(f"dwell_p_unit must be 's' or 'ms', got {dwell_p_unit!r}")
     for name, v in (("arc_tol_mm", arc_tol_mm), ("arc_tol_rel", arc_tol_rel)):
@@ -129,6 +144,7 @@ def parse(
     b = _clean(text, block_delete)
     line_starts = np.concatenate([[0], np.flatnonzero(b == 10) + 1])
     errors = _Errors(raw_lines, line_starts, source)
+    errors.fanuc = dialect == "fanuc"
     words = _lex(b, errors)
 
     # the program ends with M2/M30: nothing after it is read
@@ -144,15 +160,19 @@ def parse(
         start=start,
         references=references,
         arc_tol=(arc_tol_mm, arc_tol_rel),
+        fanuc=dialect == "fanuc",
     )
     errors.raise_all(n_lines)
     return tp
 
 
-def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, arc_tol) -> Toolpath:
+def _interpret(
+    words, n, errors: _Errors, *, inch, p_scale, start, references, arc_tol, fanuc
+) -> Toolpath:
     """Modal interpretation of the words of lines ``0..n-1``; returns the Toolpath.
 
-    ``references`` (2, 3) holds the reference points of G28 and G30 (mm).
+    ``references`` (2, 3) holds the reference points of G28 and G30 (mm); ``fanuc``: the
+    program is in the fanuc dialect.
     """
     code, value, line = words["code"], words["value"], words["line"]
     # ---- one value per line and letter; a letter twice in a line is an error (not G, M)
@@ -172,14 +192,15 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, a
     g = code == _L["G"]
     gval, gline = value[g], line[g]
     gcode = np.rint(gval * 10).astype(np.int64)
-    idx = np.minimum(np.searchsorted(_G_CODES, gcode), len(_G_CODES) - 1)
-    known = (_G_CODES[idx] == gcode) & (np.abs(gval * 10 - gcode) < 1e-6)
+    codes, groups = (_G_CODES_FANUC, _G_GROUPS_FANUC) if fanuc else (_G_CODES, _G_GROUPS)
+    idx = np.minimum(np.searchsorted(codes, gcode), len(codes) - 1)
+    known = (codes[idx] == gcode) & (np.abs(gval * 10 - gcode) < 1e-6)
     if not known.all():
         errors.at_pos(
             words["pos"][g][~known],
-            lambda pos: _g_reason(float(value[np.searchsorted(words["pos"], pos)])),
+            lambda pos: _g_reason(float(value[np.searchsorted(words["pos"], pos)]), fanuc),
         )
-    gcode, gline, grp = gcode[known], gline[known], _G_GROUPS[idx[known]]
+    gcode, gline, grp = gcode[known], gline[known], groups[idx[known]]
     g80 = gcode == 800
     if g80.any():  # read_g: G80 gives way to another motion code of its line (or G80)
         taken = np.zeros(n, dtype=bool)
@@ -284,16 +305,20 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, a
         feed_line & np.isnan(feed), lambda i: f"{_fmt_g(int(motion[i]))} with no feed rate set (F)"
     )
 
+    rigid = None
+    if fanuc:  # M29 rigid tapping; M98/M99 and K repeats refused
+        rigid = _fanuc_words(code, value, line, has, G, motion, cycle_line, errors)
+
     # ---- words that need a motion to use them
     p_ok = dwell_line | g64 | arc_line | (cycle_line & _DWELLS[motion])
     errors.at_lines(
         has["P"] & ~p_ok,
         "P word without G2, G3, G4, G64 or a canned cycle that dwells"
-        " (G74, G82, G84, G86, G88, G89)",
+        f" (G74{', G76' if fanuc else ''}, G82, G84, G86, G88, G89)",
     )
     errors.at_lines(
-        has["Q"] & ~(g64 | (cycle_line & _PECKS[motion])),
-        "Q word without G64, G73 or G83",
+        has["Q"] & ~(g64 | (cycle_line & (_Q_FANUC if fanuc else _PECKS)[motion])),
+        f"Q word without G64, G73{', G76' if fanuc else ''} or G83",
     )
     errors.at_lines(
         (ijk & ~(arc_line | (cycle_line & (motion == 870))))
@@ -328,7 +353,7 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, a
         L = _Lines(
             W, has, G, scale, motion, plane, incremental,
             _ffill(G[_RETRACT] >= 0, G[_RETRACT] == 990, True),
-            _spindle(code, value, line, n), p_scale,
+            _spindle(code, value, line, n), p_scale, rigid,
         )  # fmt: skip
         pos, off = _special_positions(
             L, axis_given, axis_val, hl, home_mm, cycle_line, moves, start, errors, cycles
@@ -406,9 +431,12 @@ def _interpret(words, n, errors: _Errors, *, inch, p_scale, start, references, a
     )
 
 
-def _g_reason(gval: float) -> str:
-    """Why a G-code is not read."""
+def _g_reason(gval: float, fanuc: bool = False) -> str:
+    """Why a G-code is not read (in the fanuc dialect if ``fanuc``)."""
     code, name = int(np.rint(gval * 10)), f"G{gval:g}"
+    if fanuc:
+        what = (_G_NOT_FANUC | _G_LINUXCNC | _G_FOREIGN | _G_FANUC_NAMES).get(code)
+        return f"{name} ({what}) {_NOT_FANUC}" if what else f"{name} is not supported"
     if code in _G_LINUXCNC:
         return f"{name} {_G_LINUXCNC[code]} {_NEEDS_LINUXCNC}"
     if code in _G_FOREIGN:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..toolpath import Toolpath
 from ._errors import _NEEDS_LINUXCNC, GCodeError
+from ._fanuc import check_dialect
 from ._interp import interpreter_available, read_linuxcnc
 from ._reader import parse as parse_native
 from ._reader import read_text
@@ -16,11 +17,12 @@ from ._reader import read_text
 #: The values of ``reader``.
 READERS = ("native", "linuxcnc", "auto")
 #: Keyword arguments only the native reader takes (LinuxCNC has its own rules for them).
-_NATIVE_ONLY = ("dwell_p_unit", "start_mm", "arc_tol_mm", "arc_tol_rel")
+_NATIVE_ONLY = ("dwell_p_unit", "dialect", "start_mm", "arc_tol_mm", "arc_tol_rel")
 #: Keyword arguments only LinuxCNC's interpreter takes.
 _LINUXCNC_ONLY = ("tool_table", "max_moves", "timeout_s", "folder")
 _NATIVE_DEFAULTS = {
     "dwell_p_unit": "s",
+    "dialect": "rs274ngc",
     "start_mm": (0.0, 0.0, 0.0),
     "arc_tol_mm": 0.005,
     "arc_tol_rel": 0.001,
@@ -73,10 +75,11 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
         ``source``, ``units``, ``block_delete``, ``g28_reference_mm`` and ``g30_reference_mm``
         (the points G28 and G30 return to, LinuxCNC's parameters #5161-#5163 and #5181-#5183:
         X, Y, Z in mm in the Toolpath's coordinates, which a G92 offset does not move; default
-        zero, as in LinuxCNC) for both readers; ``dwell_p_unit``, ``start_mm``, ``arc_tol_mm``,
-        ``arc_tol_rel`` for the native reader only (with ``reader="linuxcnc"`` only their
-        defaults are allowed; with ``"auto"`` a non-default one keeps the program on the native
-        reader); ``tool_table``, ``max_moves``, ``timeout_s``, ``folder`` for the interpreter
+        zero, as in LinuxCNC) for both readers; ``dwell_p_unit``, ``dialect`` (``"rs274ngc"``
+        or ``"fanuc"``), ``start_mm``, ``arc_tol_mm``, ``arc_tol_rel`` for the native reader
+        only (with ``reader="linuxcnc"`` only their defaults are allowed; with ``"auto"`` a
+        non-default one, such as ``dialect="fanuc"``, keeps the program on the native reader);
+        ``tool_table``, ``max_moves``, ``timeout_s``, ``folder`` for the interpreter
         only.
 
     Returns
@@ -91,6 +94,7 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
         For a bad ``reader`` or keyword argument, naming it, its value and what is allowed.
     """
     _check_reader(reader)
+    check_dialect(kwargs.get("dialect", "rs274ngc"))
     native = {k: v for k, v in kwargs.items() if k not in _LINUXCNC_ONLY}
     interp = {k: v for k, v in kwargs.items() if k not in _NATIVE_ONLY}
     changed = [k for k in _NATIVE_ONLY if k in kwargs and _differs(kwargs[k], k)]
@@ -124,6 +128,8 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
 
 def _differs(value, name: str) -> bool:
     default = _NATIVE_DEFAULTS[name]
+    if value is None and name == "dwell_p_unit":  # the dialect's: "s" in the default one
+        return False
     if name == "start_mm":
         return tuple(float(v) for v in value) != default
     return value != default
