@@ -53,7 +53,7 @@ export ONEDNN_MAX_CPU_ISA := AVX2
 endif
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean linuxcnc record calibrate FORCE
+        clean distclean linuxcnc record calibrate lab FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> linuxcnc -> notebooks (papermill) -> book; prints the HTML path"
@@ -65,6 +65,7 @@ help:
 	@echo "make record      re-record data/recordings/linuxcnc/ on LinuxCNC (needs make linuxcnc)"
 	@echo "make calibrate   fit linuxcnc_sim's [control.fir] to its recordings, into its profile file"
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
+	@echo "make lab         open notebooks/ in JupyterLab with the project's kernel; prints the URL"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
 	@echo "make clean       remove book/_build, build/, book/_vendor/ (keeps results/, data/cache/)"
@@ -94,6 +95,19 @@ venv:
 	$(PY) -m ipykernel install --sys-prefix --name python3 --display-name "Python 3 (nctwin)" >/dev/null; \
 	echo "$$hash" > $(VENV_STAMP); \
 	echo "venv: ready in $$(( $$(date +%s) - t0 )) s"
+
+# ---------------------------------------------------------------------------------------------
+# lab: JupyterLab on notebooks/ with the venv's kernel ("Python 3 (nctwin)", installed by venv).
+# A notebook finds data/ and writes results/<stem>/ through the package (nctwin.paths), whatever
+# the kernel's working folder. JupyterLab prints the URL with its token; without a display (no
+# DISPLAY or WAYLAND_DISPLAY) it opens no browser, and as root (a container) it passes
+# --allow-root. LAB_PORT picks the port (default 8888, the next free one if taken).
+LAB_PORT ?= 8888
+lab: venv
+	@browser=$$([ -n "$${DISPLAY:-}$${WAYLAND_DISPLAY:-}" ] || echo --no-browser); \
+	root=$$([ "$$(id -u)" != 0 ] || echo --allow-root); \
+	echo "lab: JupyterLab on notebooks/ (kernel \"Python 3 (nctwin)\"); open the URL it prints"; \
+	$(VENV)/bin/jupyter lab --ServerApp.root_dir="$(CURDIR)/notebooks" --port=$(LAB_PORT) $$browser $$root
 
 # ---------------------------------------------------------------------------------------------
 # mathjax: the book loads MathJax from its own _static/mathjax/ (no CDN). tex-svg.js loads its es5
