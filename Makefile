@@ -53,7 +53,7 @@ export ONEDNN_MAX_CPU_ISA := AVX2
 endif
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean linuxcnc record calibrate lab FORCE
+        clean distclean linuxcnc record calibrate lab chapter FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> linuxcnc -> notebooks (papermill) -> book; prints the HTML path"
@@ -66,6 +66,7 @@ help:
 	@echo "make calibrate   fit linuxcnc_sim's [control.fir] to its recordings, into its profile file"
 	@echo "make notebooks   execute notebooks/*.ipynb into book/notebooks/ (cwd = repo root)"
 	@echo "make lab         open notebooks/ in JupyterLab with the project's kernel; prints the URL"
+	@echo "make chapter NB=<chapter> PROGRAM=<file>   one chapter on your program, into build/chapter/"
 	@echo "make book        jupyter-book build book -W (offline)"
 	@echo "make bench       run every benchmarks/*.py (JSON lines on stdout)"
 	@echo "make clean       remove book/_build, build/, book/_vendor/ (keeps results/, data/cache/)"
@@ -108,6 +109,14 @@ lab: venv
 	root=$$([ "$$(id -u)" != 0 ] || echo --allow-root); \
 	echo "lab: JupyterLab on notebooks/ (kernel \"Python 3 (nctwin)\"); open the URL it prints"; \
 	$(VENV)/bin/jupyter lab --ServerApp.root_dir="$(CURDIR)/notebooks" --port=$(LAB_PORT) $$browser $$root
+
+# chapter: one chapter on a reader's own input, e.g. make chapter NB=chien2023_bilstm
+# PROGRAM=part.ngc (PARAMS="-p name value" sets other parameters). The executed notebook and its
+# HTML go to build/chapter/, its tables to build/chapter/<stem>/results/; results/ and
+# book/notebooks/ are not touched (nctwin.report.chapter).
+chapter: venv
+	@if [ -z "$(NB)" ]; then echo "chapter: say which, e.g. make chapter NB=chien2023_bilstm PROGRAM=part.ngc" >&2; exit 2; fi
+	@$(PY) -m nctwin.report.chapter "$(NB)" $(if $(PROGRAM),--program "$(PROGRAM)") $(PARAMS)
 
 # ---------------------------------------------------------------------------------------------
 # mathjax: the book loads MathJax from its own _static/mathjax/ (no CDN). tex-svg.js loads its es5

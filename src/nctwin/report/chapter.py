@@ -1,0 +1,129 @@
+"""Run one chapter on a reader's program: ``make chapter NB=<notebook> PROGRAM=<file>``.
+
+``python -m nctwin.report.chapter NOTEBOOK [--program FILE] [-p NAME VALUE ...] [--out DIR]``
+executes the notebook with papermill (``program`` set to FILE made absolute, and each ``-p``: a
+number where VALUE reads as one, else a string), headless, in the repository root,
+and writes the executed notebook and its HTML to ``DIR/<stem>.ipynb`` and ``DIR/<stem>.html``
+(default ``build/chapter/``). The chapter's tables and claims go to ``DIR/<stem>/results/``
+(through ``NCTWIN_RESULTS``): ``results/``, ``book/notebooks/`` and the committed notebooks are
+never touched. The networks come from the chapter's cache in ``data/cache/`` (a chapter that has
+not run before trains them first).
+
+A notebook or program that does not exist is named in one line before anything runs (exit 2); a
+chapter that fails names its partly executed notebook (exit 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from .. import paths
+
+__all__ = ["execute", "main", "resolve_notebook"]
+
+#: Where a chapter run on a reader's program writes, under the repository root.
+OUT_DIR = Path("build") / "chapter"
+
+
+def resolve_notebook(name: str, root: Path) -> Path:
+    """The chapter notebook ``name`` names: a path, or a stem of ``notebooks/`` (with or
+    without ``.ipynb``).
+
+    Raises
+    ------
+    ValueError
+        If no such notebook exists; the message lists the chapters.
+    """
+    for candidate in (Path(name), root / "notebooks" / Path(name).with_suffix(".ipynb").name):
+        if candidate.is_file() and candidate.suffix == ".ipynb":
+            return candidate.resolve()
+    stems = ", ".join(sorted(p.stem for p in (root / "notebooks").glob("*.ipynb")))
+    raise ValueError(f"NB={name}: no such notebook; the chapters are {stems}")
+
+
+def execute(notebook: Path, out_dir: Path, parameters: dict, root: Path) -> Path:
+    """Execute ``notebook`` with papermill into ``out_dir`` and write its HTML beside it.
+
+    Returns
+    -------
+    pathlib.Path
+        The HTML file.
+    """
+    import nbformat
+    import papermill
+    from nbconvert import HTMLExporter
+    from traitlets.config import Config
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    executed = out_dir / notebook.name
+    os.environ["NCTWIN_RESULTS"] = str(out_dir / notebook.stem / "results")
+    os.environ.setdefault("MPLBACKEND", "module://matplotlib_inline.backend_inline")
+    os.environ.setdefault("TQDM_DISABLE", "1")
+    papermill.execute_notebook(
+        str(notebook), str(executed), parameters=parameters, cwd=str(root),
+        kernel_name="python3", progress_bar=False,
+        config=Config(KernelManager={"transport": "ipc"}),
+        extra_arguments=["--InteractiveShell.colors=nocolor"],
+    )  # fmt: skip
+    body, _ = HTMLExporter().from_notebook_node(nbformat.read(executed, as_version=4))
+    html = executed.with_suffix(".html")
+    html.write_text(body, encoding="utf-8")
+    return html
+
+
+def _value(text: str) -> int | float | str:
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line; see the module's docstring."""
+    parser = argparse.ArgumentParser(prog="python -m nctwin.report.chapter")
+    parser.add_argument("notebook", help="a chapter: a notebook path or a stem of notebooks/")
+    parser.add_argument("--program", help="a G-code file the chapter runs its method on")
+    parser.add_argument(
+        "-p",
+        "--parameter",
+        nargs=2,
+        action="append",
+        default=[],
+        metavar=("NAME", "VALUE"),
+        help="another parameter of the chapter",
+    )
+    parser.add_argument("--out", help=f"output folder (default {OUT_DIR}/ in the repository)")
+    args = parser.parse_args(argv)
+    root = paths.repo_root()
+    try:
+        notebook = resolve_notebook(args.notebook, root)
+        parameters = {name: _value(v) for name, v in args.parameter}
+        if args.program:
+            program = Path(args.program).resolve()
+            if not program.is_file():
+                raise ValueError(f"PROGRAM={args.program}: no such file")
+            parameters["program"] = str(program)
+    except ValueError as exc:
+        print(f"chapter: {exc}", file=sys.stderr)
+        return 2
+    out_dir = Path(args.out).resolve() if args.out else root / OUT_DIR
+    from papermill.exceptions import PapermillExecutionError
+
+    try:
+        html = execute(notebook, out_dir, parameters, root)
+    except PapermillExecutionError as exc:
+        print(f"chapter: {notebook.stem} failed in cell {exc.exec_count}: {exc.ename}: "
+              f"{exc.evalue}; the partly executed notebook is {out_dir / notebook.name}",
+              file=sys.stderr)  # fmt: skip
+        return 1
+    print(f"chapter: {out_dir / notebook.name}\nchapter: {html}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
