@@ -56,7 +56,7 @@ from .controls import AccDecControl, FirControl, PlannerControl, SequenceControl
 from .estimate import block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner
 from .identify import at_rapid_override, fit_block_overlap, fit_fir, fit_planner
-from .machine import Machine, write_control
+from .machine import Machine, Profile, write_control
 from .runtimes import ProgramLines, RunTimes, first_changes, first_m6, motion_window
 from .toolpath import Toolpath
 
@@ -192,6 +192,18 @@ class Calibration:
     fit_err_pct: dict
     best: str
     runs: tuple
+
+    def profile(self, method: str | None = None) -> Profile:
+        """The profile ``nctwin estimate`` would read for ``method`` (of :data:`METHODS`;
+        default :attr:`best`): the machine and the method's control as :func:`write_profile`
+        writes them, and the non-motion times."""
+        method = self.best if method is None else method
+        if method not in METHODS:
+            raise ValueError(f"method = {method!r} is out of range: allowed {', '.join(METHODS)}")
+        machine = self.machine if method in ("cam", "kernel") else self.planner_machine
+        control = {"planner": {"planner": self.planner}, "kernel": {"fir": self.fir},
+                   "block_overlap": {"accdec": self.block_overlap}}.get(method, {})  # fmt: skip
+        return Profile(machine, **control, sequence=self.sequence, default_method=method)
 
 
 def sequence_s(lines: ProgramLines, seq: SequenceControl, *, window: bool = True) -> float:
@@ -443,7 +455,7 @@ def _vec(v) -> str:
 def write_profile(cal: Calibration, output: str | Path, *, today: date) -> None:
     """Write ``cal`` as a profile file: ``[machine]``, ``default_method`` (``cal.best``), the
     best method's control table and ``[control.sequence]``, each with its provenance."""
-    m = cal.machine if cal.best in ("cam", "kernel") else cal.planner_machine
+    m = cal.profile().machine
     out = Path(output)
     out.write_text(
         f"# {m.name}, calibrated from {len(cal.runs)} valid runs of its MTConnect logs\n"

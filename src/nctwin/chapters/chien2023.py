@@ -48,7 +48,6 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -69,7 +68,6 @@ from ..report.tables import Claim, error_pct, side_by_side
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath
-from .your_program import ProgramResult, domain_notes, run_program, time_table
 
 __all__ = [
     "LSTM_CONFIG",
@@ -92,13 +90,13 @@ __all__ = [
     "plot_feed_per_line",
     "predict_run",
     "recording_effects",
+    "run_toolpath",
     "seed_rows",
     "simulate",
     "simulate_one",
     "time_by_length",
     "train_config",
     "write_programs",
-    "your_program",
 ]
 
 #: Cache format version (part of every cache key).
@@ -194,12 +192,18 @@ def cutting_blocks(tp: Toolpath) -> Toolpath:
 def simulate_one(
     text: str, profile: Profile, recording: Recording | None = None, index: int = 0
 ) -> ProgramRun:
-    """Parse ``text``, keep its cutting blocks, run them on the FIR kernel (the profile's
-    machine and ``[control.fir]``) and read the targets.
+    """Parse ``text``, keep its cutting blocks and :func:`run_toolpath` them."""
+    return run_toolpath(cutting_blocks(gcode.parse(text)), profile, recording, index)
+
+
+def run_toolpath(
+    tp: Toolpath, profile: Profile, recording: Recording | None = None, index: int = 0
+) -> ProgramRun:
+    """Run the G-lines ``tp`` from rest to rest on the FIR kernel (the profile's machine and
+    ``[control.fir]``) and read the targets.
 
     ``index`` seeds the recording's noise together with ``recording.seed``.
     """
-    tp = cutting_blocks(gcode.parse(text))
     control = profile.control("fir")
     motion = fir.run(tp, profile.machine, control)
     if recording is not None:
@@ -389,46 +393,6 @@ def predict_run(
     feed = np.mean([p[0] for p in preds], axis=0)
     t = np.mean([p[1] for p in preds], axis=0)
     return feed, t, float(t.sum())
-
-
-def your_program(
-    path, models: Trained | Sequence[Trained], profile: Profile, train_runs: Sequence[ProgramRun]
-) -> ProgramResult:
-    """The BiLSTM on a reader's program, beside the FIR kernel's time for it (the truth) and CAM.
-
-    The program's planar G1 moves are what the method reads (:func:`cutting_blocks`, as for the
-    chapter's own programs); its arcs, rapids and plunges are left out of the truth and the
-    prediction alike.
-
-    Parameters
-    ----------
-    path : str or path-like
-        A G-code file.
-    models : Trained or sequence of Trained
-        The chapter's network or ensemble (see :func:`predict_run`), never retrained here.
-    profile : Profile
-        The machine and ``[control.fir]`` the networks were trained on.
-    train_runs : sequence of ProgramRun
-        Their training programs, for where the program leaves the training data.
-    """
-
-    def method(text: str, source: str) -> ProgramResult:
-        tp = gcode.parse(text, source=source)
-        kept = len(cutting_blocks(tp))
-        if kept == 0:
-            raise ValueError(f"{source}: no planar G1 move, the G-lines the BiLSTM reads")
-        run = simulate_one(text, profile)
-        feed, _, t_s = predict_run(models, run)
-        x_train = np.concatenate([r.features for r in train_runs])
-        notes = (f"{kept} planar G1 moves of the program's {len(tp)} blocks are the G-lines "
-                 "read; its arcs, rapids and plunges are left out of every time.",
-                 *domain_notes(run.features, x_train, chien.FEATURES))  # fmt: skip
-        feeds = {"line": np.arange(1, kept + 1), "true_mm_s": run.targets[:, 0],
-                 "BiLSTM_mm_s": feed}  # fmt: skip
-        times = time_table(("FIR kernel", run.measured_s), {"BiLSTM": t_s, "CAM": run.cam_s})
-        return ProgramResult(Path(source).name, times, pd.DataFrame(feeds), notes)
-
-    return run_program(path, method)
 
 
 def seed_rows(

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -44,6 +45,7 @@ from ..programs.iso10791 import TEST_PIECE_FILE, test_piece_program
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, accuracy_pct, error_pct
 from ..toolpath import MotionKind, Toolpath
+from .your_program import ProgramResult, block_feeds, program_times, run_program
 
 __all__ = [
     "BEATS_CAM_FACTOR",
@@ -66,6 +68,7 @@ __all__ = [
     "program_statistics_table",
     "program_text",
     "truth_effects_table",
+    "your_program",
 ]
 
 #: The programs' names in the tables.
@@ -140,6 +143,44 @@ def load_program(name: str) -> Toolpath:
     tp = parse_file(path)
     check_program(tp, str(path))
     return tp
+
+
+def your_program(
+    path, machine: Machine, sets: dict[int, tuple[AccDecControl, FanucControl]],
+    inpos: dict[int, np.ndarray], param_set: int = 1,
+) -> ProgramResult:  # fmt: skip
+    """Lee's block-overlap estimate of a reader's program beside the Fanuc-like truth's time
+    for it and CAM, with the parameter set ``param_set`` (its time constants for both).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A G-code file; a construct the estimator cannot model
+        (:func:`nctwin.methods.lee2022.check_program`) or the truth cannot run is the reason.
+    machine, sets, inpos
+        As for :func:`accuracy_table`.
+    param_set : int
+        Which of ``sets``.
+    """
+    model, truth = sets[param_set]
+
+    def method(text: str, source: str) -> ProgramResult:
+        tp = parse(text, source=source)
+        check_program(tp, source)
+        est = block_overlap(tp, machine, model, inposition_s=inpos[param_set])
+        run = fanuc.simulate(tp, machine, truth)
+        cam_est = cam(tp, machine)
+        times = program_times(
+            ("Fanuc-like truth", run.cycle_time_s),
+            {"block overlap": est.cycle_time_s, "CAM": cam_est.cycle_time_s},
+        )
+        feeds = block_feeds(tp.lengths_mm, {"true_mm_s": run.block_times_s,
+                                            "block overlap_mm_s": est.block_times_s,
+                                            "CAM_mm_s": cam_est.block_times_s})  # fmt: skip
+        note = (f"parameter set {param_set}; {len(tp)} blocks {tp.kind_counts()}",)
+        return ProgramResult(Path(source).name, times, feeds, note)
+
+    return run_program(path, method)
 
 
 def program_statistics_table(texts: dict[str, str]) -> pd.DataFrame:

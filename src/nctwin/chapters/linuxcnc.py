@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -36,6 +37,8 @@ from ..estimate.cam import cam
 from ..estimate.kernel import kernel
 from ..estimate.learned import (
     MoveData,
+    bilstm_move_times,
+    model_blocks,
     move_data,
     predict_axis_nn,
     predict_bilstm,
@@ -43,11 +46,14 @@ from ..estimate.learned import (
 )
 from ..gcode import parse
 from ..identify import identified_block_overlap
+from ..kernel import linuxcnc
 from ..learn.train import Trained
 from ..machine import Machine, Profile
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, error_pct
+from ..targets import block_targets
 from ..toolpath import MotionKind, PathMode, Toolpath
+from .your_program import ProgramResult, block_feeds, program_times, run_program
 
 __all__ = [
     "EVERY_PROGRAM_SETS",
@@ -61,6 +67,7 @@ __all__ = [
     "path_control",
     "planner_ablation",
     "planner_block_gaps",
+    "your_program",
 ]
 
 
@@ -131,6 +138,55 @@ def method_rows(
                  "predicted_s": t, "err_pct": error_pct(t, data.measured_s, signed=True)}
             )  # fmt: skip
     return pd.DataFrame(rows, columns=list(METHOD_COLUMNS))
+
+
+def your_program(
+    path,
+    profile: Profile,
+    fir_fitted: FirControl,
+    planner_fitted: Machine,
+    bilstm: Trained,
+    axis_nns: Sequence[Trained],
+) -> ProgramResult:
+    """Every method of the chapter on a reader's program beside LinuxCNC's time for it,
+    recorded live (:func:`nctwin.kernel.linuxcnc.run`) where LinuxCNC is installed; elsewhere
+    without a truth, and a note says why.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A G-code file.
+    profile, fir_fitted, planner_fitted, bilstm, axis_nns
+        As for :func:`method_rows`: the chapter's machine, its fitted controls and its trained
+        networks (never retrained here).
+    """
+    machine, planner = profile.machine, profile.control("planner")
+
+    def method(text: str, source: str) -> ProgramResult:
+        tp = parse(text, source=source)
+        times = analytic_times(tp, profile, fir_fitted, planner_fitted)
+        data = move_data(source, tp, machine, planner)
+        times["bilstm"] = predict_bilstm(bilstm, data)
+        times["axis_nn"] = predict_axis_nn(axis_nns, data)
+        _, moves_of = model_blocks(tp)
+        block_s = {
+            "planner_mm_s": blend_planner(tp, machine, planner).block_times_s,
+            "bilstm_mm_s": np.bincount(moves_of, bilstm_move_times(bilstm, data), len(tp)),
+        }
+        truth, why = None, linuxcnc.available()
+        if why is None:
+            try:
+                motion = linuxcnc.run(text, machine, planner)
+            except (linuxcnc.LinuxCNCAborted, TimeoutError) as exc:
+                why = f"LinuxCNC did not finish it: {exc}"
+            else:
+                truth = ("LinuxCNC", motion.cycle_time_s)
+                block_s = {"true_mm_s": block_targets(motion, tp).time_s} | block_s
+        notes = () if why is None else (f"no truth: {why}",)
+        return ProgramResult(Path(source).name, program_times(truth, times),
+                             block_feeds(tp.lengths_mm, block_s), notes)  # fmt: skip
+
+    return run_program(path, method)
 
 
 def path_control(tp: Toolpath, profile: Profile) -> str:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -38,6 +39,7 @@ from ..report.tables import Claim, error_pct
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath
+from .your_program import ProgramResult, block_feeds, domain_notes, program_times, run_program
 
 __all__ = [
     "MODELS",
@@ -52,13 +54,14 @@ __all__ = [
     "predict_feeds",
     "predict_time",
     "predict_times",
+    "program_times",
     "run_pocket",
     "run_pockets",
     "seed_table",
     "target_time",
-    "time_table",
     "train_ensembles",
     "training_table",
+    "your_program",
 ]
 
 #: Training pockets of the paper's two models (Table 2); both validate on the first half of
@@ -403,6 +406,46 @@ def seed_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.D
             "seed_min_err_pct": e.min(), "seed_max_err_pct": e.max(),
         })  # fmt: skip
     return pd.DataFrame(rows)
+
+
+def your_program(
+    path, members: list[list[Trained]], profile: Profile, runs: dict[int, PocketRun]
+) -> ProgramResult:
+    """Sun's per-axis networks on a reader's program beside the machine's time for it (the FIR
+    kernel of ``profile``, the chapter's simulated Siemens, from the origin) and CAD/CAM.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A G-code file.
+    members : list of [X, Y, Z network]
+        The chapter's model, one member per seed (:func:`predict_time`), never retrained here.
+    profile : Profile
+        The chapter's machine.
+    runs : dict of PocketRun
+        The chapter's pockets, for where the program leaves the training data.
+    """
+
+    def method(text: str, source: str) -> ProgramResult:
+        parse(text, source=source)  # a program the reader cannot read is named by its file
+        run = run_pocket(text, 0, profile)
+        nn_s, _ = predict_time(members, run)
+        lengths = run.toolpath.lengths_mm
+        nn_block_s = sun.block_times_s(predict_feeds(members, run), lengths, run.commanded_mm_s)
+        true_block_s = np.diff(block_targets(run.motion, run.toolpath).junction_sample)
+        feeds = block_feeds(lengths, {"true_mm_s": true_block_s * run.motion.period_s,
+                                      "model_mm_s": nn_block_s})  # fmt: skip
+        names = tuple(f"{a} {f}" for a in "XYZ" for f in sun.FEATURES)
+        train = np.concatenate([r.features for r in runs.values()]).reshape(-1, len(names))
+        arcs = int(np.isin(run.toolpath.kind, (MotionKind.ARC_CW, MotionKind.ARC_CCW)).sum())
+        notes = (f"{len(run.toolpath)} cutter locations, {arcs} of them ends of arcs, which the "
+                 "networks' features read as chords (the paper's programs are lines).",
+                 *domain_notes(run.features.reshape(len(run.toolpath), -1), train, names,
+                               rows="cutter locations"))  # fmt: skip
+        times = program_times(("machine", run.measured_s), {"model": nn_s, "CAD/CAM": run.cam_s})
+        return ProgramResult(Path(source).name, times, feeds, notes)
+
+    return run_program(path, method)
 
 
 def target_time(run: PocketRun, target: str = "measured", kinds=None) -> float:

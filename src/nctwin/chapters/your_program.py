@@ -26,7 +26,14 @@ import pandas as pd
 from ..gcode import read_text
 from ..report.tables import error_pct, show
 
-__all__ = ["ProgramResult", "domain_notes", "run_program", "show_program", "time_table"]
+__all__ = [
+    "ProgramResult",
+    "block_feeds",
+    "domain_notes",
+    "program_times",
+    "run_program",
+    "show_program",
+]
 
 
 @dataclass(frozen=True)
@@ -58,7 +65,7 @@ class ProgramResult:
     reason: str | None = None
 
 
-def time_table(truth: tuple[str, float] | None, others: dict[str, float]) -> pd.DataFrame:
+def program_times(truth: tuple[str, float] | None, others: dict[str, float]) -> pd.DataFrame:
     """Cycle times with their signed errors against the truth.
 
     Parameters
@@ -80,6 +87,33 @@ def time_table(truth: tuple[str, float] | None, others: dict[str, float]) -> pd.
         err = np.nan if truth is None else error_pct(t, truth[1], signed=True)
         rows.append({"source": label, "cycle_time_s": t, "err_pct": err})
     return pd.DataFrame(rows)
+
+
+def block_feeds(length_mm: np.ndarray, times_s: dict[str, np.ndarray]) -> pd.DataFrame:
+    """Average feed per G-line from each source's time per block: length over time, for the
+    blocks that move (dwells and zero-length blocks are left out; a block given no time has
+    no average feed, NaN).
+
+    Parameters
+    ----------
+    length_mm : ndarray, shape (N,)
+        Path length of each block.
+    times_s : dict
+        ``column -> ndarray, shape (N,)``: each source's time per block (``true_mm_s`` for the
+        truth's column).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``line`` (the block's number from 1, among all N) and one column per source, one row
+        per moving block.
+    """
+    moving = length_mm > 0
+    out = {"line": np.flatnonzero(moving) + 1}
+    for col, t in times_s.items():
+        t = np.asarray(t, dtype=float)[moving]
+        out[col] = np.divide(length_mm[moving], t, out=np.full(len(t), np.nan), where=t > 0)
+    return pd.DataFrame(out)
 
 
 def run_program(path: str | PathLike, method: Callable[[str, str], ProgramResult]) -> ProgramResult:

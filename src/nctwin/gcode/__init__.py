@@ -117,8 +117,8 @@ from ._interp import TIMEOUT_S_PER_MB as TIMEOUT_S_PER_MB
 from ._interp import interpreter_available
 from ._modal import MAX_BLOCKS_PER_LINE as MAX_BLOCKS_PER_LINE
 from ._modal import MM_PER_INCH as MM_PER_INCH
-from ._select import READERS as READERS
 from ._reader import read_text
+from ._select import READERS as READERS
 from ._select import ReadResult, parse, parse_file, read, read_file
 
 __all__ = [
