@@ -53,7 +53,7 @@ export ONEDNN_MAX_CPU_ISA := AVX2
 endif
 
 .PHONY: help venv mathjax chromium notebooks book reproduce test lint unit nbval browser bench \
-        clean distclean linuxcnc record calibrate lab chapter FORCE
+        clean distclean linuxcnc record calibrate lab chapter chapter-runs FORCE
 
 help:
 	@echo "make reproduce   venv -> mathjax -> linuxcnc -> notebooks (papermill) -> book; prints the HTML path"
@@ -281,7 +281,7 @@ reproduce:
 # make test installs LinuxCNC (make linuxcnc) and requires its live tests to run (they fail
 # instead of skipping): the real NC kernel and the shipped recordings are proven, not assumed.
 test: export NCTWIN_REQUIRE_LINUXCNC := 1
-test: venv linuxcnc lint unit nbval browser
+test: venv linuxcnc lint unit nbval chapter-runs browser
 	@echo "test: all steps passed"
 
 lint: venv
@@ -289,6 +289,12 @@ lint: venv
 
 unit: venv
 	$(PY) -m pytest
+
+# chapter-runs: every chapter through papermill on a reader's input (tests/test_chapter_runs.py,
+# marked `chapter`, which a plain pytest leaves out): the "Your ..." section is there and
+# results/ is unchanged. After nbval, whose executions leave the networks in the cache.
+chapter-runs: venv | $(EXECUTED)
+	$(PY) -m pytest -m chapter -p no:cacheprovider tests/test_chapter_runs.py
 
 # nbval re-executes the notebooks in the environment papermill executed them in (inline figures,
 # no progress bars on stderr): a checked cell whose training outlasts the bar's delay would

@@ -45,7 +45,7 @@ from ..programs.iso10791 import TEST_PIECE_FILE, test_piece_program
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, accuracy_pct, error_pct
 from ..toolpath import MotionKind, Toolpath
-from .your_program import ProgramResult, block_feeds, program_times, run_program
+from .your_program import ProgramResult, block_feeds, block_summary, program_times, run_program
 
 __all__ = [
     "BEATS_CAM_FACTOR",
@@ -177,7 +177,7 @@ def your_program(
         feeds = block_feeds(tp.lengths_mm, {"true_mm_s": run.block_times_s,
                                             "block overlap_mm_s": est.block_times_s,
                                             "CAM_mm_s": cam_est.block_times_s})  # fmt: skip
-        note = (f"parameter set {param_set}; {len(tp)} blocks {tp.kind_counts()}",)
+        note = (f"parameter set {param_set}; {block_summary(tp)}",)
         return ProgramResult(Path(source).name, times, feeds, note)
 
     return run_program(path, method)

@@ -25,10 +25,12 @@ import pandas as pd
 
 from ..gcode import read_text
 from ..report.tables import error_pct, show
+from ..toolpath import Toolpath
 
 __all__ = [
     "ProgramResult",
     "block_feeds",
+    "block_summary",
     "domain_notes",
     "program_times",
     "run_program",
@@ -116,6 +118,13 @@ def block_feeds(length_mm: np.ndarray, times_s: dict[str, np.ndarray]) -> pd.Dat
     return pd.DataFrame(out)
 
 
+def block_summary(tp: Toolpath) -> str:
+    """``"87 blocks: 8 rapid, 75 linear, 4 arc_ccw"``: a program's blocks by kind (kinds it
+    does not have left out)."""
+    kinds = ", ".join(f"{n} {kind}" for kind, n in tp.kind_counts().items() if n)
+    return f"{len(tp)} blocks: {kinds}"
+
+
 def run_program(path: str | PathLike, method: Callable[[str, str], ProgramResult]) -> ProgramResult:
     """Read ``path`` and run ``method(text, name)`` on it.
 
@@ -124,6 +133,10 @@ def run_program(path: str | PathLike, method: Callable[[str, str], ProgramResult
     and line), gives a result with that one line as its ``reason``.
     """
     name = Path(path).name
+    if Path(path).is_dir():
+        return ProgramResult(name, reason=f"{path}: is a directory, not a program")
+    if not Path(path).is_file():
+        return ProgramResult(name, reason=f"{path}: no such file")
     try:
         text, _ = read_text(path)
         return method(text, str(path))
@@ -170,8 +183,8 @@ def _plot_feeds(feeds: pd.DataFrame, name: str, truth_label: str) -> None:
 def domain_notes(
     x: np.ndarray, x_train: np.ndarray, names: tuple[str, ...], *, rows: str = "G-lines"
 ) -> tuple[str, ...]:
-    """Where a program's inputs leave the training data: one line per input whose value lies
-    outside the range the networks were trained on, for some rows.
+    """Where a program's inputs leave the training data: one line naming each input with values
+    outside the range the networks were trained on, and the share of rows that have them.
 
     Parameters
     ----------
@@ -187,14 +200,13 @@ def domain_notes(
     Returns
     -------
     tuple of str
-        ``"<name>: <share> % of the <rows> outside the training range <lo> to <hi>"`` per input
-        concerned; empty when every input lies inside.
+        Empty when every input lies inside its training range, else one line, ``"outside the
+        training range (share of the <rows>): <name> <share> % (<lo> to <hi>), ..."``.
     """
     lo, hi = np.nanmin(x_train, axis=0), np.nanmax(x_train, axis=0)
-    out = (x < lo) | (x > hi)
-    return tuple(
-        f"{name}: {100 * out[:, j].mean():.3g} % of the {rows} outside the training range "
-        f"{lo[j]:.4g} to {hi[j]:.4g}"
-        for j, name in enumerate(names)
-        if out[:, j].any()
-    )
+    share = 100 * ((x < lo) | (x > hi)).mean(axis=0)
+    parts = [f"{name} {share[j]:.3g} % ({lo[j]:.4g} to {hi[j]:.4g})"
+             for j, name in enumerate(names) if share[j] > 0]  # fmt: skip
+    if not parts:
+        return ()
+    return (f"outside the training range (share of the {rows}): " + ", ".join(parts),)

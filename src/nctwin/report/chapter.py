@@ -24,6 +24,8 @@ from .. import paths
 
 __all__ = ["execute", "main", "resolve_notebook"]
 
+#: The kernel's figures: inline (the Makefile's notebooks use the same backend).
+NB_MPLBACKEND = "module://matplotlib_inline.backend_inline"
 #: Where a chapter run on a reader's program writes, under the repository root.
 OUT_DIR = Path("build") / "chapter"
 
@@ -59,15 +61,24 @@ def execute(notebook: Path, out_dir: Path, parameters: dict, root: Path) -> Path
 
     out_dir.mkdir(parents=True, exist_ok=True)
     executed = out_dir / notebook.name
-    os.environ["NCTWIN_RESULTS"] = str(out_dir / notebook.stem / "results")
-    os.environ.setdefault("MPLBACKEND", "module://matplotlib_inline.backend_inline")
-    os.environ.setdefault("TQDM_DISABLE", "1")
-    papermill.execute_notebook(
-        str(notebook), str(executed), parameters=parameters, cwd=str(root),
-        kernel_name="python3", progress_bar=False,
-        config=Config(KernelManager={"transport": "ipc"}),
-        extra_arguments=["--InteractiveShell.colors=nocolor"],
-    )  # fmt: skip
+    env = {"NCTWIN_RESULTS": str(out_dir / notebook.stem / "results"),
+           "MPLBACKEND": NB_MPLBACKEND,
+           "TQDM_DISABLE": "1"}  # fmt: skip
+    before = {k: os.environ.get(k) for k in env}
+    os.environ.update(env)  # the kernel inherits them
+    try:
+        papermill.execute_notebook(
+            str(notebook), str(executed), parameters=parameters, cwd=str(root),
+            kernel_name="python3", progress_bar=False,
+            config=Config(KernelManager={"transport": "ipc"}),
+            extra_arguments=["--InteractiveShell.colors=nocolor"],
+        )  # fmt: skip
+    finally:
+        for k, v in before.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
     body, _ = HTMLExporter().from_notebook_node(nbformat.read(executed, as_version=4))
     html = executed.with_suffix(".html")
     html.write_text(body, encoding="utf-8")

@@ -1,0 +1,96 @@
+"""A reader's own program through a chapter: the shared pieces, and `make chapter`'s runner."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from nctwin import gcode
+from nctwin.chapters import your_program as yp
+from nctwin.chapters.chien2023 import cutting_blocks
+from nctwin.chapters.chien2023_yours import chains
+from nctwin.paths import repo_root
+from nctwin.report import chapter
+
+EXAMPLE = repo_root() / "data" / "programs" / "examples" / "bracket.ngc"
+
+
+def test_program_times_errors_against_the_truth():
+    t = yp.program_times(("truth", 20.0), {"method": 21.0, "CAM": 15.0})
+    assert list(t.source) == ["truth", "method", "CAM"]
+    assert np.isnan(t.err_pct[0])
+    assert t.err_pct[1:].tolist() == pytest.approx([5.0, -25.0])
+
+
+def test_program_times_without_a_truth_has_no_errors():
+    t = yp.program_times(None, {"method": 21.0})
+    assert t.cycle_time_s.tolist() == [21.0] and t.err_pct.isna().all()
+
+
+def test_block_feeds_are_length_over_time_of_the_moving_blocks():
+    lengths = np.array([10.0, 0.0, 6.0, 4.0])
+    feeds = yp.block_feeds(lengths, {"true_mm_s": np.array([0.5, 2.0, 0.2, 0.0])})
+    assert feeds.line.tolist() == [1, 3, 4]  # the dwell (length 0) is left out
+    assert feeds.true_mm_s[:2].tolist() == pytest.approx([20.0, 30.0])
+    assert np.isnan(feeds.true_mm_s[2])  # no time, no average feed
+
+
+def test_domain_notes_name_the_inputs_outside_the_training_range():
+    train = np.array([[65.0, 1.0], [100.0, 5.0]])
+    x = np.array([[50.0, 2.0], [80.0, 3.0], [90.0, 4.0], [120.0, 2.0]])
+    notes = yp.domain_notes(x, train, ("feed", "length"))
+    assert notes == ("outside the training range (share of the G-lines): feed 50 % (65 to 100)",)
+    assert yp.domain_notes(x[1:3], train, ("feed", "length")) == ()
+
+
+def test_run_program_names_a_file_it_cannot_read(tmp_path):
+    def method(text, source):
+        pytest.fail("ran")
+
+    absent = yp.run_program(tmp_path / "absent.ngc", method)
+    assert absent.reason == f"{tmp_path / 'absent.ngc'}: no such file"
+    assert absent.name == "absent.ngc" and absent.times.empty and absent.feeds is None
+    assert yp.run_program(tmp_path, method).reason == f"{tmp_path}: is a directory, not a program"
+
+
+def test_run_program_turns_a_refused_program_into_one_line(tmp_path):
+    path = tmp_path / "bad.ngc"
+    path.write_text("G21 G90\nG1 X10 F100\nG1 X20 Y5 Q\n", encoding="utf-8")
+
+    def method(text, source):
+        gcode.parse(text, source=source)
+        pytest.fail("parsed a bad program")
+
+    result = yp.run_program(path, method)
+    assert result.reason.startswith(f"{path}:3: ") and "\n" not in result.reason
+
+
+def test_block_summary_counts_the_kinds_the_program_has():
+    tp = gcode.parse(EXAMPLE.read_text(encoding="utf-8"), reader="native")
+    assert yp.block_summary(tp) == "87 blocks: 8 rapid, 75 linear, 4 arc_ccw"
+
+
+def test_chains_cut_the_g_lines_where_the_path_jumps():
+    tp = cutting_blocks(gcode.parse(EXAMPLE.read_text(encoding="utf-8"), reader="native"))
+    parts = chains(tp)
+    assert sum(len(p) for p in parts) == len(tp)
+    for p in parts:
+        assert np.array_equal(p.start_mm[1:], p.end_mm[:-1])
+    # the face's zig-zag, the contour's four lines (its arcs are not G-lines) and the slot
+    assert [len(p) for p in parts] == [21, 1, 1, 1, 1, 47]
+
+
+def test_chapter_runner_names_what_does_not_exist(capsys):
+    assert chapter.main(["no_such_chapter"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("chapter: NB=no_such_chapter: no such notebook; the chapters are ")
+    assert "chien2023_bilstm" in err and err.count("\n") == 1
+    assert chapter.main(["chien2023_bilstm", "--program", "absent.ngc"]) == 2
+    assert capsys.readouterr().err == "chapter: PROGRAM=absent.ngc: no such file\n"
+
+
+def test_chapter_runner_finds_a_chapter_by_stem_or_path():
+    root = repo_root()
+    by_stem = chapter.resolve_notebook("lee2022_block_overlap", root)
+    assert by_stem == chapter.resolve_notebook("notebooks/lee2022_block_overlap.ipynb", root)
+    assert by_stem == chapter.resolve_notebook("lee2022_block_overlap.ipynb", root)
