@@ -166,6 +166,16 @@ def test_write_profile_reads_back(hand_program, tmp_path):
     assert profile.sequence == cal.sequence
     assert profile.default_method == cal.best
     assert "Residuals: tool change 3 spans" in out.read_text()
+    # the profile read back is the one Calibration.profile builds, machine and control alike
+    assert profile == cal.profile()
+    for method, kind in (("planner", "planner"), ("kernel", "fir"),
+                         ("block_overlap", "accdec")):  # fmt: skip
+        other = cal.profile(method)
+        assert other.default_method == method and other.sequence == cal.sequence
+        assert getattr(other, kind) is not None
+    assert cal.profile("cam").machine == cal.machine
+    with pytest.raises(ValueError, match="method = 'bilstm' is out of range"):
+        cal.profile("bilstm")
 
 
 @pytest.mark.slow

@@ -8,6 +8,12 @@ import pandas as pd
 import pytest
 
 from nctwin.report.claims import format_claim, report_claims
+from nctwin.report.conditions import (
+    CONDITION_COLUMNS,
+    Condition,
+    conditions_table,
+    report_conditions,
+)
 from nctwin.report.tables import Claim, format_table, write_claims
 
 CLAIMS = [
@@ -56,3 +62,53 @@ def test_duplicate_ids_write_and_print_nothing(tmp_path, capsys):
         report_claims("nb", [CLAIMS[0], CLAIMS[0]], results_dir=tmp_path)
     assert capsys.readouterr().out == ""
     assert not (tmp_path / "nb" / "claims.json").exists()
+
+
+def test_a_claim_under_an_unmet_condition_is_not_tested(tmp_path, capsys):
+    conditions = [
+        Condition("lines", "G-lines (paper Sec. 3)", 5000, 4993, tol_pct=1.0),
+        Condition("rate", "sampling rate (paper Sec. 2)", 1000, 5, "Hz", tol_pct=10.0),
+    ]
+    claims = [Claim("a", "needs the lines", 1.0, "<", 2.0, requires=("lines",)),
+              Claim("b", "needs both", 1.0, "<", 2.0, requires=("lines", "rate")),
+              Claim("c", "ours, fails", 3.0, "<", 2.0, whose="ours")]  # fmt: skip
+    report_claims("nb", claims, conditions=conditions, results_dir=tmp_path)
+    assert capsys.readouterr().out == (
+        "holds  a: 1.00 < 2\nnot tested  b: 1.00 < 2  [unmet: rate]\nFAILS  c: 3.00 < 2\n"
+    )
+    records = json.loads((tmp_path / "nb" / "claims.json").read_text())
+    assert [r["status"] for r in records] == ["holds", "not tested", "fails"]
+    assert records[1]["unmet"] == ["rate"] and "unmet" not in records[0]
+    assert [r["whose"] for r in records] == ["paper", "paper", "ours"]
+
+
+def test_a_claim_requiring_an_unknown_condition_writes_nothing(tmp_path):
+    claim = Claim("a", "t", 1.0, "<", 2.0, requires=("nowhere",))
+    with pytest.raises(ValueError, match=r"claim 'a' requires conditions not given: \['nowhere'\]"):
+        report_claims("nb", [claim], results_dir=tmp_path)
+    assert not (tmp_path / "nb").exists()
+
+
+def test_conditions_by_tolerance_or_bounds(tmp_path):
+    # 4993 lines against the paper's 5000 within 1 %: [4950, 5050]
+    within = Condition("lines", "t", 5000, 4993, tol_pct=1.0)
+    assert within.bounds == (4950.0, 5050.0) and within.met
+    assert not Condition("rate", "t", 2.9, 5.0, "Hz", tol_pct=25.0).met  # 5 > 3.625
+    assert Condition("data", "t", float("nan"), 90, "programs", low=80).met
+    assert not Condition("data", "t", float("nan"), float("nan"), low=80).met  # not measured
+    with pytest.raises(ValueError, match="give tol_pct or low/high"):
+        Condition("x", "t", 1.0, 1.0)
+    with pytest.raises(ValueError, match="needs a finite paper value"):
+        Condition("x", "t", float("nan"), 1.0, tol_pct=5.0)
+    table = conditions_table([within])
+    assert list(table.columns) == list(CONDITION_COLUMNS) and table.met.tolist() == [True]
+
+
+def test_report_conditions_writes_the_csv_and_refuses_repeated_ids(tmp_path, capsys):
+    c = Condition("lines", "G-lines", 5000, 4993, tol_pct=1.0)
+    assert report_conditions("nb", [c], results_dir=tmp_path) == [c]
+    text = (tmp_path / "nb" / "conditions.csv").read_text()
+    assert text == "id,text,paper,ours,unit,low,high,met\nlines,G-lines,5000,4993,,4950,5050,True\n"
+    assert "4993" in capsys.readouterr().out
+    with pytest.raises(ValueError, match=r"condition ids repeat: \['lines'\]"):
+        report_conditions("nb", [c, c], results_dir=tmp_path)

@@ -237,10 +237,18 @@ def test_claim_to_dict_is_the_results_contract():
         "op": "<",
         "threshold": 2.5,
         "holds": True,
+        "whose": "paper",
+        "status": "holds",
     }
     nan = Claim("x", "t", float("nan"), "<", 1.0).to_dict()
-    assert nan["value"] is None and nan["holds"] is False
+    assert nan["value"] is None and nan["holds"] is False and nan["status"] == "fails"
     json.dumps(nan, allow_nan=False)  # valid JSON
+    # a claim whose conditions are unmet is not tested: it neither holds nor fails
+    untested = Claim("y", "t", 1.0, "<", 2.0, whose="ours", requires=("a", "b"), unmet=("b",))
+    assert untested.holds and untested.status == "not tested"
+    assert untested.to_dict()["unmet"] == ["b"] and untested.to_dict()["whose"] == "ours"
+    with pytest.raises(ValueError, match="whose = 'mine' is out of range: allowed paper, ours"):
+        Claim("z", "t", 1.0, "<", 2.0, whose="mine")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -302,7 +310,8 @@ def test_write_claims_json(tmp_path):
     records = json.loads(text)
     assert [r["id"] for r in records] == ["b", "a"]  # the caller's order
     assert [r["holds"] for r in records] == [True, False]
-    assert set(records[0]) == {"id", "text", "value", "op", "threshold", "holds"}
+    assert set(records[0]) == {"id", "text", "value", "op", "threshold", "holds", "whose",
+                               "status"}  # fmt: skip
     assert sorted(p.name for p in path.parent.iterdir()) == ["claims.json"]
 
 

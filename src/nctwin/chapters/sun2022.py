@@ -533,6 +533,7 @@ def claims(sources: pd.DataFrame, table3: pd.DataFrame) -> list[Claim]:
             float(cam_under),
             "==",
             1.0,
+            whose="ours",
         )
     )
     return claims

@@ -17,21 +17,33 @@ are); ``table=True`` prints the claims as a table instead, one row per
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from .conditions import Condition
 from .tables import Claim, format_table, write_claims
 
-__all__ = ["LINE", "VERDICTS", "Claim", "claims_by_seed", "format_claim", "report_claims"]
+__all__ = [
+    "LINE",
+    "NOT_TESTED",
+    "VERDICTS",
+    "Claim",
+    "claims_by_seed",
+    "format_claim",
+    "report_claims",
+]
 
 #: The line printed per claim: ``str.format`` fields ``verdict``, ``id``, ``text``, ``value``,
 #: ``op`` and ``threshold``.
 LINE = "{verdict}  {id}: {value:.2f} {op} {threshold:g}"
-#: The verdict words: (claim holds, claim fails).
+#: The verdict words: (claim holds, claim fails). A claim whose conditions are unmet prints
+#: :data:`NOT_TESTED` and the unmet conditions' ids after the line.
 VERDICTS = ("holds", "FAILS")
+NOT_TESTED = "not tested"
 
 
 def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VERDICTS) -> str:
@@ -50,14 +62,10 @@ def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VER
     -------
     str
     """
-    return line.format(
-        verdict=verdicts[0] if claim.holds else verdicts[1],
-        id=claim.id,
-        text=claim.text,
-        value=claim.value,
-        op=claim.op,
-        threshold=claim.threshold,
-    )
+    verdict = NOT_TESTED if claim.unmet else verdicts[0] if claim.holds else verdicts[1]
+    text = line.format(verdict=verdict, id=claim.id, text=claim.text, value=claim.value,
+                       op=claim.op, threshold=claim.threshold)  # fmt: skip
+    return text + (f"  [unmet: {', '.join(claim.unmet)}]" if claim.unmet else "")
 
 
 def report_claims(
@@ -67,6 +75,7 @@ def report_claims(
     line: str = LINE,
     verdicts: tuple[str, str] = VERDICTS,
     table: bool = False,
+    conditions: Iterable[Condition] | None = None,
     results_dir: Path | None = None,
 ) -> None:
     """Write the claims to ``results/<stem>/claims.json`` and print them.
@@ -86,15 +95,26 @@ def report_claims(
     table : bool
         Print one table of the claims' records (:func:`~nctwin.report.tables.format_table`)
         instead of one line per claim.
+    conditions : iterable of Condition, optional
+        The chapter's conditions (:func:`~nctwin.report.conditions.report_conditions`): each
+        claim's unmet ones (of its ``requires``) make it not tested.
     results_dir : pathlib.Path, optional
         Results folder; default ``paths.results_dir()``.
 
     Raises
     ------
     ValueError
-        If two claims share an id (nothing is written).
+        If two claims share an id, or a claim requires a condition not among ``conditions``
+        (nothing is written).
     """
+    met = {c.id: c.met for c in conditions or ()}
     claims = list(claims)
+    for c in claims:
+        unknown = [r for r in c.requires if r not in met]
+        if unknown:
+            raise ValueError(f"claim {c.id!r} requires conditions not given: {unknown}")
+    claims = [dataclasses.replace(c, unmet=tuple(r for r in c.requires if not met[r]))
+              for c in claims]  # fmt: skip
     write_claims(stem, claims, results_dir=results_dir)
     if table:
         print(format_table(pd.DataFrame([c.to_dict() for c in claims])))

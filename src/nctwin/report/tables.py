@@ -29,7 +29,8 @@ Joining
 Results files
     CSV with ``,`` separators, ``\n`` line ends, no index, floats written with
     :data:`FLOAT_FORMAT` (``"%.6g"``, six significant digits); ``claims.json`` is a list of
-    ``{"id", "text", "value", "op", "threshold", "holds"}`` with sorted keys and an indent of 2.
+    ``{"id", "text", "value", "op", "threshold", "holds", "whose", "status"}`` (and ``"unmet"``
+    where a claim's conditions are unmet, :class:`Claim`) with sorted keys and an indent of 2.
     Both are written atomically: to a temporary file in the target folder, then ``os.replace``.
 """
 
@@ -56,6 +57,7 @@ __all__ = [
     "FLOAT_FORMAT",
     "META_COLUMNS",
     "OPS",
+    "WHOSE",
     "Claim",
     "UnknownTableError",
     "accuracy_pct",
@@ -81,6 +83,9 @@ META_COLUMNS: tuple[str, ...] = (*CITING_COLUMNS, "note")
 
 FLOAT_FORMAT: str = "%.6g"
 """printf-style format of floats in results CSV files and in :func:`format_table`."""
+
+#: Whose a claim is (:attr:`Claim.whose`).
+WHOSE = ("paper", "ours")
 
 OPS: dict[str, Callable[[float, float], bool]] = {
     "<": operator.lt,
@@ -412,11 +417,20 @@ class Claim:
         One of ``"<"``, ``"<="``, ``">"``, ``">="``, ``"=="``.
     threshold
         The bound the value is compared with, in the same unit as ``value``.
+    whose
+        ``"paper"``: the paper's own claim at its own level; ``"ours"``: a check of the
+        project's own (a program beyond the paper's, an ablation), which cites no paper section.
+    requires
+        Ids of the conditions (:class:`~nctwin.report.conditions.Condition`) the claim is
+        tested under: where one is unmet, the claim is not tested.
+    unmet
+        Those of ``requires`` that are unmet (set by
+        :func:`~nctwin.report.claims.report_claims` from the chapter's conditions).
 
     Raises
     ------
     ValueError
-        If ``op`` is not one of :data:`OPS`.
+        If ``op`` is not one of :data:`OPS`, or ``whose`` not one of :data:`WHOSE`.
     """
 
     id: str
@@ -424,12 +438,19 @@ class Claim:
     value: float
     op: str
     threshold: float
+    whose: str = "paper"
+    requires: tuple[str, ...] = ()
+    unmet: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.op not in OPS:
             raise ValueError(f"op must be one of {list(OPS)}, got {self.op!r}")
+        if self.whose not in WHOSE:
+            raise ValueError(f"whose = {self.whose!r} is out of range: allowed {', '.join(WHOSE)}")
         object.__setattr__(self, "value", float(self.value))
         object.__setattr__(self, "threshold", float(self.threshold))
+        object.__setattr__(self, "requires", tuple(self.requires))
+        object.__setattr__(self, "unmet", tuple(self.unmet))
 
     @property
     def holds(self) -> bool:
@@ -438,19 +459,33 @@ class Claim:
             return False
         return bool(OPS[self.op](self.value, self.threshold))
 
+    @property
+    def status(self) -> str:
+        """``"not tested"`` where a condition it requires is unmet (it neither holds nor
+        fails), else ``"holds"`` or ``"fails"``."""
+        if self.unmet:
+            return "not tested"
+        return "holds" if self.holds else "fails"
+
     def to_dict(self) -> dict[str, Any]:
-        """Return the JSON record ``{"id", "text", "value", "op", "threshold", "holds"}``.
+        """Return the JSON record ``{"id", "text", "value", "op", "threshold", "holds", "whose",
+        "status"}``, and ``"unmet"`` (the unmet conditions' ids) where there are any.
 
         NaN numbers become ``None`` (JSON ``null``), since JSON has no NaN.
         """
-        return {
+        out = {
             "id": self.id,
             "text": self.text,
             "value": None if math.isnan(self.value) else self.value,
             "op": self.op,
             "threshold": None if math.isnan(self.threshold) else self.threshold,
             "holds": self.holds,
+            "whose": self.whose,
+            "status": self.status,
         }
+        if self.unmet:
+            out["unmet"] = list(self.unmet)
+        return out
 
 
 # ----------------------------------------------------------------------------------------------
