@@ -74,6 +74,7 @@ def test_a_program_the_chapter_cannot_run_gets_one_line(tmp_path):
     bad.write_text("G21 G90\nG64 P0.05\nG1 X10 F600\nM30\n", encoding="utf-8")
     texts, errors = _run("lee2022_block_overlap", {"program": str(bad)}, tmp_path / "out")
     assert errors == []
+    # the first move under the tolerance is named (line 3), as the estimator checks moves
     assert texts == ["## Your program: `tolerance.ngc`",
-                     f"not run: {bad}:2: G64 P blending tolerance: the block-overlap method has "
+                     f"not run: {bad}:3: G64 P blending tolerance: the block-overlap method has "
                      "no path tolerance\n"]  # fmt: skip
