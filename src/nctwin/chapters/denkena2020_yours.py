@@ -245,12 +245,14 @@ def make_process(
         errors.append(f"feed_direction = {direction!r}: allowed for {kind} "
                       f"{', '.join(KIND_DIRECTIONS[kind])}")  # fmt: skip
     d = TOOL.diameter_mm
-    ae = {"groove": ("ae_mm", f["ae_mm"], d, d, {"lo_closed": True, "hi_closed": True}),
-          "side": ("ae_mm", f["ae_mm"], 0.0, d, {})}.get(
-        kind, ("ae_mm", f["ae_mm"], 0.0, d, {"hi_closed": True}))  # fmt: skip
+    ae, checks = f["ae_mm"], []
+    if kind == "groove" and ae != d:
+        errors.append(f"ae_mm = {ae!r}: allowed {d:g} for a groove (the tool's diameter)")
+    elif kind != "groove":
+        checks.append(("ae_mm", ae, 0.0, d, {"hi_closed": kind != "side"}))
     n_max = 60.0 * machine.servo_rate_hz / (2 * TOOL.teeth)
     errors += _errors([
-        ae,
+        *checks,
         ("ap_mm", f["ap_mm"], 0.0, FLUTE_LENGTH_MM, {"hi_closed": True}),
         ("vf_mm_min", f["vf_mm_min"], 0.0, math.inf, {}),
         ("n_rpm", f["n_rpm"], 0.0, n_max, {"hi_closed": True}),
