@@ -69,6 +69,16 @@ def test_chapter_runs_your_program(stem, tmp_path):
     assert not any(t.startswith("not run:") for t in texts)
 
 
+def test_denkena_runs_your_process(tmp_path):
+    texts, errors = _run("denkena2020_force_lstm", {"process": "groove,+x,10,1,600,5000"},
+                         tmp_path)  # fmt: skip
+    assert errors == []
+    assert texts[0] == ("## Your process: groove milling +x, ae 10 mm, ap 1 mm, vf 600 mm/min, "
+                        "n 5000 1/min")  # fmt: skip
+    assert "lstm_cutting_rmse_n" in texts[1]
+    assert not any(t.startswith("not run:") for t in texts)
+
+
 def test_a_program_the_chapter_cannot_run_gets_one_line(tmp_path):
     bad = tmp_path / "tolerance.ngc"
     bad.write_text("G21 G90\nG64 P0.05\nG1 X10 F600\nM30\n", encoding="utf-8")
