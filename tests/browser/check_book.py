@@ -240,8 +240,8 @@ def check_dom(dom: str, report: PageReport, is_notebook: bool) -> None:
         report.problems.append("page should hold math but has none")
     if is_notebook and report.tables == 0:
         report.problems.append("notebook page shows no <table>")
-    if report.page == VERDICTS and report.tables != 1:
-        report.problems.append(f"the Verdicts page should hold one table, found {report.tables}")
+    if report.page == VERDICTS and report.tables == 0:
+        report.problems.append("the Verdicts page should hold a table of claims per chapter")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -241,13 +241,16 @@ def render(chapters: list[ChapterClaims]) -> str:
         "Each row: the claim, whose it is, the value the paper reports where the claim quotes "
         "one, ours, the bar (our value against the threshold), the verdict and the section of "
         "the chapter that explains it. A claim that fails is kept and explained there.",
-        "",
-        ":::{container} nctwin-verdicts",
-        "| chapter | claim | whose | paper | ours | bar | verdict | explained in |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for chapter in chapters:
-        short = chapter.title.split(":")[0]
+        lines += [
+            "",
+            f"### {chapter.title.split(':')[0]}",
+            "",
+            ":::{container} nctwin-verdicts",
+            "| claim | whose | paper | ours | bar | verdict | explained in |",
+            "| --- | --- | --- | --- | --- | --- | --- |",
+        ]
         for r in chapter.claims:
             heading, slug = section_of(chapter, r["id"])
             target = f"notebooks/{chapter.stem}.ipynb" + (f"#{slug}" if slug else "")
@@ -256,12 +259,12 @@ def render(chapters: list[ChapterClaims]) -> str:
                 f" (unmet: {', '.join(r['unmet'])})" if status == "not tested" else ""
             )
             lines.append(
-                f"| {_cell(short)} | {_cell(r['text'])} (`{_cell(r['id'])}`) "
-                f"| {r.get('whose', 'paper')} | {_cell(paper_value(r))} | {_number(r['value'])} "
-                f"| {r['op']} {_number(r['threshold'])} | {verdict} "
+                f"| {_cell(r['text'])} (`{_cell(r['id'])}`) | {r.get('whose', 'paper')} "
+                f"| {_cell(paper_value(r))} | {_number(r['value'])} "
+                f"| {r['op']}&nbsp;{_number(r['threshold'])} | {verdict} "
                 f"| [{_cell(heading)}]({target}) |"
             )
-    lines.append(":::")
+        lines.append(":::")
     return "\n".join(lines) + "\n"
 
 
