@@ -14,7 +14,7 @@ For every content page (``intro.html``, the other top-level pages and every ``no
   math, every math element contains MathJax output (``<mjx-container>``), with no MathJax error and
   no raw TeX (``\\(``, ``\\[``, ``$$``, ``\\frac``, ...) left in the visible text;
 * the intro and "what is simulated" pages hold math at all;
-* every notebook page holds at least one ``<table>``, and the Verdicts page exactly one;
+* every notebook page holds at least one ``<table>``, and the Verdicts page one per chapter;
 * laid out in a 1280 x 900 window (a script added to a temporary copy of the page measures it):
   no visible table is wider than the text column, or scrolls sideways inside it; no code cell's
   input is visible (the chapters hide their code under "Show code cell source"); and the visible
