@@ -79,6 +79,15 @@ def test_denkena_runs_your_process(tmp_path):
     assert not any(t.startswith("not run:") for t in texts)
 
 
+def test_zhang_runs_your_surface(tmp_path):
+    surface = ROOT / "data" / "surfaces" / "examples" / "saddle.csv"
+    texts, errors = _run("zhang2023_step_error", {"surface": str(surface)}, tmp_path)
+    assert errors == []
+    assert texts[0] == "## Your surface: `saddle.csv`"
+    assert "share_below_0.5um_pct" in texts[1]
+    assert not any(t.startswith("not run:") for t in texts)
+
+
 def test_a_program_the_chapter_cannot_run_gets_one_line(tmp_path):
     bad = tmp_path / "tolerance.ngc"
     bad.write_text("G21 G90\nG64 P0.05\nG1 X10 F600\nM30\n", encoding="utf-8")

@@ -40,6 +40,7 @@ __all__ = [
     "PAPER_SURFACES",
     "BumpSurface",
     "Cylinder",
+    "GridSurface",
     "Sphere",
     "ToolPath",
     "iso_parametric_path",
@@ -315,7 +316,105 @@ class Cylinder:
         return jet
 
 
-Surface = BumpSurface | Sphere | Cylinder
+@dataclass(frozen=True, eq=False)
+class GridSurface:
+    r"""A height field :math:`z = h(x, y)` given on a grid, interpolated by a bicubic spline
+    through every grid point (:class:`scipy.interpolate.RectBivariateSpline`, no smoothing).
+
+    :math:`S(u, v) = (x_0 + u L_x,\ y_0 + v L_y,\ h)` over the grid's rectangle.
+
+    Parameters
+    ----------
+    x_mm : ndarray, shape (nx,)
+        Strictly increasing, at least 4 values.
+    y_mm : ndarray, shape (ny,)
+        Strictly increasing, at least 4 values.
+    z_mm : ndarray, shape (ny, nx)
+        Heights, row ``j`` at ``y_mm[j]``; finite.
+
+    Raises
+    ------
+    ValueError
+        If a grid axis has fewer than 4 values or does not increase, or the shapes or the
+        heights are not as above.
+    """
+
+    x_mm: np.ndarray
+    y_mm: np.ndarray
+    z_mm: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("x_mm", "y_mm"):
+            a = np.asarray(getattr(self, name), dtype=float)
+            if a.ndim != 1 or len(a) < 4 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
+                raise ValueError(
+                    f"{name} is out of range: allowed at least 4 finite, strictly increasing "
+                    f"values (got {len(a.ravel())})"
+                )
+            object.__setattr__(self, name, a)
+        z = np.asarray(self.z_mm, dtype=float)
+        if z.shape != (len(self.y_mm), len(self.x_mm)) or not np.all(np.isfinite(z)):
+            raise ValueError(
+                f"z_mm has shape {z.shape}: allowed ({len(self.y_mm)}, {len(self.x_mm)}) finite "
+                "heights"
+            )
+        object.__setattr__(self, "z_mm", z)
+
+    @cached_property
+    def _spline(self):
+        from scipy.interpolate import RectBivariateSpline
+
+        return RectBivariateSpline(self.x_mm, self.y_mm, self.z_mm.T, kx=3, ky=3, s=0)
+
+    @property
+    def size_mm(self) -> tuple[float, float]:
+        """:math:`(L_x, L_y)`."""
+        return float(self.x_mm[-1] - self.x_mm[0]), float(self.y_mm[-1] - self.y_mm[0])
+
+    def _xy(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        lx, ly = self.size_mm
+        return self.x_mm[0] + np.asarray(u, float) * lx, self.y_mm[0] + np.asarray(v, float) * ly
+
+    def height_mm(self, x_mm: np.ndarray, y_mm: np.ndarray) -> np.ndarray:
+        """Height :math:`h(x, y)` in mm at points of any (same) shape."""
+        x, y = np.broadcast_arrays(np.asarray(x_mm, float), np.asarray(y_mm, float))
+        return self._spline.ev(x.ravel(), y.ravel()).reshape(x.shape)
+
+    def point(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Surface points :math:`S(u, v)`, shape ``(*u.shape, 3)`` in mm."""
+        x, y = self._xy(u, v)
+        return np.stack([x, y, self.height_mm(x, y)], axis=-1)
+
+    def curve_jet(self, v: np.ndarray) -> CurveJet:
+        r"""``(c, c_u, c_uu)`` of the iso-``v`` curves (:data:`CurveJet`):
+        :math:`c_u = (L_x, 0, L_x h_x)`, :math:`c_{uu} = (0, 0, L_x^2 h_{xx})`."""
+        lx, _ = self.size_mm
+        y = self._xy(0.0, np.asarray(v, float))[1]
+        ev = self._spline.ev
+
+        def jet(u: np.ndarray, rows=slice(None)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            x = self._xy(np.asarray(u, float), 0.0)[0]
+            yr = np.broadcast_to(y[rows], x.shape)
+            c, c_u, c_uu = np.zeros((3, len(x), 3))
+            c[:, 0], c[:, 1], c[:, 2] = x, yr, ev(x, yr)
+            c_u[:, 0], c_u[:, 2] = lx, lx * ev(x, yr, dx=1)
+            c_uu[:, 2] = lx * lx * ev(x, yr, dx=2)
+            return c, c_u, c_uu
+
+        return jet
+
+    def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points and upward unit normals, each shape ``(*u.shape, 3)``."""
+        x, y = np.broadcast_arrays(*self._xy(u, v))
+        ev = self._spline.ev
+        hx = ev(x.ravel(), y.ravel(), dx=1).reshape(x.shape)
+        hy = ev(x.ravel(), y.ravel(), dy=1).reshape(x.shape)
+        normal = np.stack([-hx, -hy, np.ones_like(x)], axis=-1)
+        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+        return np.stack([x, y, self.height_mm(x, y)], axis=-1), normal
+
+
+Surface = BumpSurface | Sphere | Cylinder | GridSurface
 
 
 @dataclass(frozen=True, eq=False)
