@@ -72,6 +72,16 @@ help:
 	@echo "make clean       remove book/_build, build/, book/_vendor/ (keeps results/, data/cache/)"
 	@echo "make distclean   clean + remove .venv"
 
+# The kernelspec carries the settings above that fix the numbers (hash seed, time zone, the CPU
+# kernels), so that a notebook run outside make (papermill, JupyterLab, an editor) computes what
+# make computes and finds the networks make trained.
+KERNEL_ENV := PYTHONHASHSEED TZ NPY_DISABLE_CPU_FEATURES OPENBLAS_CORETYPE ATEN_CPU_CAPABILITY \
+  MKL_CBWR ONEDNN_MAX_CPU_ISA
+KERNEL_ENV_PY := import json, os, sys; \
+  p = os.path.join(sys.prefix, "share", "jupyter", "kernels", "python3", "kernel.json"); \
+  k = json.load(open(p)); k["env"] = {n: os.environ[n] for n in sys.argv[1:] if n in os.environ}; \
+  open(p, "w").write(json.dumps(k, indent=1) + "\n")
+
 # ---------------------------------------------------------------------------------------------
 # venv: reused without calling pip while the hash of requirements.txt + pyproject.toml matches.
 # PIP_NOISE drops pip's warnings about empty local index folders on the project's machines.
@@ -94,6 +104,7 @@ venv:
 	$(PY) -c 'import importlib.metadata as m, sys; v = m.version("torch"); \
 	  sys.exit(None if v.split("+")[0] == "2.13.0" else f"venv: torch {v} installed, 2.13.0 pinned")'; \
 	$(PY) -m ipykernel install --sys-prefix --name python3 --display-name "Python 3 (nctwin)" >/dev/null; \
+	$(PY) -c '$(KERNEL_ENV_PY)' $(KERNEL_ENV); \
 	echo "$$hash" > $(VENV_STAMP); \
 	echo "venv: ready in $$(( $$(date +%s) - t0 )) s"
 
