@@ -252,11 +252,11 @@ def your_surface(
                                 a[:, col["cl0_z"]]])  # fmt: skip
 
     lx, ly = surface.size_mm
+    seeds = "one seed" if len(networks) == 1 else f"the mean of {len(networks)} seeds"
     notes = (
         f"{lines} lines {ly / max(lines - 1, 1):.3g} mm apart of {points} cutter-contact points "
         f"{lx / (points - 1):.3g} mm apart, {len(exact)} segments, R = {radius_mm:g} mm; the "
-        f"networks are surface 1's ({len(networks)} seeds, their mean), not fine-tuned to this "
-        "surface.",
+        f"network is surface 1's ({seeds}), not fine-tuned to this surface.",
         *domain_notes(reach(x), reach(train_x), ("CC spacing (mm)", "R (mm)", "CL z (mm)"),
                       rows="segments"),
     )  # fmt: skip
