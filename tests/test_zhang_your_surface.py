@@ -164,6 +164,7 @@ def test_your_surface_end_to_end(tiny_net, capsys, monkeypatch):
          "tool_radius_mm = 13.0 is out of range: allowed (0, 12.8"),
         ({"step_mm": 50.0}, "step_mm = 50.0 is out of range: allowed (0, 40] mm"),
         ({"stepover_mm": -1.0}, "stepover_mm = -1.0 is out of range: allowed (0, 30] mm"),
+        ({"step_mm": "2"}, "step_mm = '2' is out of range: allowed (0, 40] mm"),
         ({"step_mm": 0.01, "stepover_mm": 0.01},
          f"segments: allowed at most {zy.MAX_SEGMENTS}"),
     ],

@@ -156,11 +156,16 @@ def read_surface(path: str | PathLike) -> GridSurface:
     return surface
 
 
+def _real(value) -> bool:
+    """Whether ``value`` is a finite real number (not a bool)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def _counts(surface: GridSurface, step_mm: float | None, stepover_mm: float | None,
             n_lines: int, n_points: int) -> tuple[int, int]:  # fmt: skip
     lx, ly = surface.size_mm
     for name, value, size in (("step_mm", step_mm, lx), ("stepover_mm", stepover_mm, ly)):
-        if value is not None and not (0 < value <= size):
+        if value is not None and not (_real(value) and 0 < value <= size):
             raise ValueError(f"{name} = {value!r} is out of range: allowed (0, {size:g}] mm")
     points = n_points if step_mm is None else math.ceil(lx / step_mm - 1e-9) + 1
     lines = n_lines if stepover_mm is None else math.ceil(ly / stepover_mm - 1e-9) + 1
@@ -175,9 +180,8 @@ def _counts(surface: GridSurface, step_mm: float | None, stepover_mm: float | No
 def _check_radius(surface: GridSurface, tool_radius_mm: float, lines: int, points: int) -> None:
     """Refuse a ball larger than the surface's smallest concave radius of curvature at the grid
     points and the path's cutter-contact points: it would gouge the surface."""
-    r = tool_radius_mm
-    if not (isinstance(r, numbers.Real) and not isinstance(r, bool) and math.isfinite(r) and r > 0):
-        raise ValueError(f"tool_radius_mm = {r!r} is out of range: allowed > 0")
+    if not (_real(tool_radius_mm) and tool_radius_mm > 0):
+        raise ValueError(f"tool_radius_mm = {tool_radius_mm!r} is out of range: allowed > 0")
     cc = surface.point(*np.meshgrid(np.linspace(0, 1, points), np.linspace(0, 1, lines)))
     kappa = max(
         float(surface.concave_curvature_per_mm(*np.meshgrid(surface.x_mm, surface.y_mm)).max()),
