@@ -413,6 +413,20 @@ class GridSurface:
         normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
         return np.stack([x, y, self.height_mm(x, y)], axis=-1), normal
 
+    def concave_curvature_per_mm(self, x_mm: np.ndarray, y_mm: np.ndarray) -> np.ndarray:
+        r"""The larger principal curvature towards the upward normal, :math:`H + \sqrt{H^2 - K}`
+        (mean curvature :math:`H`, Gaussian :math:`K` of the height field), at points of any
+        (same) shape, in 1/mm: positive where the surface is concave seen from the tool in some
+        direction. A ball of radius :math:`R` fits the surface there only if
+        :math:`R\,\kappa < 1`."""
+        x, y = np.broadcast_arrays(np.asarray(x_mm, float), np.asarray(y_mm, float))
+        p, q, r, s, t = (self._spline.ev(x.ravel(), y.ravel(), dx=i, dy=j).reshape(x.shape)
+                         for i, j in ((1, 0), (0, 1), (2, 0), (1, 1), (0, 2)))  # fmt: skip
+        w = 1 + p * p + q * q
+        gauss = (r * t - s * s) / (w * w)
+        mean = ((1 + q * q) * r - 2 * p * q * s + (1 + p * p) * t) / (2 * w**1.5)
+        return mean + np.sqrt(np.maximum(mean * mean - gauss, 0.0))
+
 
 Surface = BumpSurface | Sphere | Cylinder | GridSurface
 
