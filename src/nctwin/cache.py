@@ -2,9 +2,10 @@
 
 Generated data (simulations, trained networks) live under ``data/cache/<kind>/`` (see
 :func:`nctwin.paths.cache_dir`), named by :func:`content_key`, a SHA-256 of everything they were
-made from. Every file the package writes, cached or committed, goes through :func:`atomic_write`:
-to a temporary file in the target folder, then ``os.replace``, so that an interrupted run never
-leaves a half-written file behind.
+made from and of the CPU kernels numpy computes with (:func:`cache_path`). Every file the
+package writes, cached or committed, goes through :func:`atomic_write`: to a temporary file in
+the target folder, then ``os.replace``, so that an interrupted run never leaves a half-written
+file behind.
 """
 
 from __future__ import annotations
@@ -21,7 +22,14 @@ import numpy as np
 
 from .paths import cache_dir
 
-__all__ = ["atomic_savez", "atomic_write", "atomic_write_text", "cache_path", "content_key"]
+__all__ = [
+    "atomic_savez",
+    "atomic_write",
+    "atomic_write_text",
+    "cache_path",
+    "content_key",
+    "numpy_cpu_features",
+]
 
 
 def content_key(*parts: Any) -> str:
@@ -48,9 +56,19 @@ def content_key(*parts: Any) -> str:
     return h.hexdigest()
 
 
+def numpy_cpu_features() -> tuple[str, ...]:
+    """The CPU features numpy dispatches to here, sorted (``NPY_DISABLE_CPU_FEATURES`` turns
+    some off): the same computation rounds differently where they differ."""
+    from numpy._core._multiarray_umath import __cpu_features__
+
+    return tuple(sorted(k for k, on in __cpu_features__.items() if on))
+
+
 def cache_path(kind: str, name: str, key: str, suffix: str) -> Path:
-    """``data/cache/<kind>/<name>-<first 16 hex digits of key><suffix>``."""
-    return cache_dir() / kind / f"{name}-{key[:16]}{suffix}"
+    """``data/cache/<kind>/<name>-<16 hex digits><suffix>``: of ``key`` and of
+    :func:`numpy_cpu_features`, so that data computed with other CPU kernels (a run outside
+    ``make``, which pins them) is never read back as this run's."""
+    return cache_dir() / kind / f"{name}-{content_key(key, numpy_cpu_features())[:16]}{suffix}"
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path:
