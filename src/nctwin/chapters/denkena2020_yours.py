@@ -35,7 +35,6 @@ from ..checks import check_number
 from ..learn.train import Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
-from ..report.tables import show
 from .denkena2020 import _PROCESS_NAMES, reconstruct, table2
 from .denkena2020_bench import (
     DIRECTIONS,
@@ -46,7 +45,7 @@ from .denkena2020_bench import (
     process_windows,
     run_processes,
 )
-from .your_program import domain_notes
+from .your_program import domain_notes, show_section
 
 __all__ = [
     "FIELDS",
@@ -375,16 +374,8 @@ def your_process(
 def show_process(result: ProcessResult) -> None:
     """Display the "Your process" section: a heading, then the reason it was not run, or the
     table, the notes and the forces over time."""
-    from IPython.display import Markdown, display
-
-    display(Markdown(f"## Your process: {result.name}"))
-    if result.reason is not None:
-        print(f"not run: {result.reason}")
-        return
-    show(result.table)
-    for note in result.notes:
-        print(note)
-    _plot_forces(result)
+    if show_section(f"Your process: {result.name}", result.reason, result.table, result.notes):
+        _plot_forces(result)
 
 
 def _plot_forces(result: ProcessResult) -> None:

@@ -35,6 +35,7 @@ __all__ = [
     "program_times",
     "run_program",
     "show_program",
+    "show_section",
 ]
 
 
@@ -144,19 +145,30 @@ def run_program(path: str | PathLike, method: Callable[[str, str], ProgramResult
         return ProgramResult(name, reason=str(exc).splitlines()[0])
 
 
+def show_section(
+    heading: str, reason: str | None, table: pd.DataFrame, notes: tuple[str, ...]
+) -> bool:
+    """The opening every "Your ..." section shares: the heading (Markdown, level 2), then
+    ``not run: <reason>``, or the table and the notes. Returns whether the input was run (the
+    caller draws its figure then)."""
+    from IPython.display import Markdown, display
+
+    display(Markdown(f"## {heading}"))
+    if reason is not None:
+        print(f"not run: {reason}")
+        return False
+    show(table)
+    for note in notes:
+        print(note)
+    return True
+
+
 def show_program(result: ProgramResult, *, truth_label: str = "truth") -> None:
     """Display the "Your program" section: a heading, then the reason or the table, the notes
     and the average feed per G-line along the program."""
-    from IPython.display import Markdown, display
-
-    display(Markdown(f"## Your program: `{result.name}`"))
-    if result.reason is not None:
-        print(f"not run: {result.reason}")
-        return
-    show(result.times)
-    for note in result.notes:
-        print(note)
-    if result.feeds is not None:
+    shown = show_section(f"Your program: `{result.name}`", result.reason, result.times,
+                         result.notes)  # fmt: skip
+    if shown and result.feeds is not None:
         _plot_feeds(result.feeds, result.name, truth_label)
 
 

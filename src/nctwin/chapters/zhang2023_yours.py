@@ -39,8 +39,8 @@ import pandas as pd
 from ..learn.train import Trained
 from ..physics.steperror import sample_columns, step_error_samples, step_error_um
 from ..physics.surfaces import GridSurface, iso_parametric_path
-from ..report.tables import load_paper_table, show
-from .your_program import domain_notes
+from ..report.tables import load_paper_table
+from .your_program import domain_notes, show_section
 from .zhang2023_seeds import ensemble_um
 
 __all__ = [
@@ -272,16 +272,8 @@ def your_surface(
 def show_surface(result: SurfaceResult) -> None:
     """Display the "Your surface" section: a heading, then the reason, or the table, the notes
     and the exact step error, the network's and their difference over the surface."""
-    from IPython.display import Markdown, display
-
-    display(Markdown(f"## Your surface: `{result.name}`"))
-    if result.reason is not None:
-        print(f"not run: {result.reason}")
-        return
-    show(result.table)
-    for note in result.notes:
-        print(note)
-    _plot_surface(result)
+    if show_section(f"Your surface: `{result.name}`", result.reason, result.table, result.notes):
+        _plot_surface(result)
 
 
 def _plot_surface(result: SurfaceResult) -> None:
