@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from nctwin import gcode
@@ -94,3 +95,38 @@ def test_chapter_runner_finds_a_chapter_by_stem_or_path():
     by_stem = chapter.resolve_notebook("lee2022_block_overlap", root)
     assert by_stem == chapter.resolve_notebook("notebooks/lee2022_block_overlap.ipynb", root)
     assert by_stem == chapter.resolve_notebook("lee2022_block_overlap.ipynb", root)
+
+
+def test_nist_learned_rows_swap_the_window_moves_and_keep_the_rest(tmp_path, monkeypatch):
+    """Each fold's network time of the window's moves replaces the calibrated estimate's; its
+    dwell, sequence and approach times stay; the table holds the median over the folds."""
+    from types import SimpleNamespace
+
+    from nctwin.chapters import nist_hurco_yours as ny
+
+    path = tmp_path / "p.ngc"  # line 1 before the window; lines 2-5 in it (the dwell too)
+    path.write_text("G0 X0\nG1 X10 F600\nG1 X20\nG4 P1\nG1 X30\nM30\n")
+    cal_blocks = np.array([0.5, 1.0, 1.0, 1.0, 1.0])  # the dwell block holds its 1 s
+    fake = SimpleNamespace(
+        motion_time_s=None, cycle_time_s=float(cal_blocks.sum()) + 2.0,  # 2 s of sequence
+        estimate=SimpleNamespace(block_times_s=cal_blocks),
+    )  # fmt: skip
+    cals = {f"{k}.NC": SimpleNamespace(profile=lambda m: m) for k in "ABC"}
+    nets = {("A.NC", "bilstm"): 5.0, ("B.NC", "bilstm"): 9.0, ("C.NC", "bilstm"): 7.0}
+    nets |= {(f, "axis_nn"): 3.0 for f in cals}
+    monkeypatch.setattr(ny, "MACHINES", ("M",))
+    monkeypatch.setattr(ny, "_held_out", lambda name: (None, cals))
+    monkeypatch.setattr(ny, "cycle_time", lambda tp, profile: fake)
+    monkeypatch.setattr(ny.nist_learned, "program_times", lambda *a: (nets, ("note",)))
+    table = pd.DataFrame({"machine": ["M"] * 2, "method": ["calibrated"] * 2,
+                          "error_pct": [1.0, -2.0], "cycle_error_pct": [3.0, -4.0]})  # fmt: skip
+    result = ny.your_program(path, table)
+    assert result.reason is None and result.notes[-1] == "note"
+    t = result.times.set_index("method").predicted_s
+    # calibrated 6.5 s; its window moves 3 s; bilstm median over folds 7 s: 6.5 - 3 + 7
+    assert t.to_dict() == pytest.approx(
+        {"calibrated": 6.5, "block_overlap": 6.5, "cam": 6.5, "bilstm": 10.5, "axis_nn": 6.5}
+    )
+    row = result.times[result.times.method == "calibrated"].iloc[0]
+    assert (row.half_width_pct, row.high_s) == pytest.approx((4.0, 6.5 * 1.04))
+    assert row.nominal_pct == pytest.approx(100 * 2 / 3)

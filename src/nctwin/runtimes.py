@@ -75,7 +75,12 @@ def program_lines(path: str | Path) -> tuple[ProgramLines, Toolpath]:
     """Read a program (:func:`nctwin.gcode.parse_file`) and find its timed lines."""
     path = Path(path)
     tp = parse_file(path)
-    text = path.read_text().split("\n")
+    return timed_lines(tp, path.read_text(), path.name), tp
+
+
+def timed_lines(tp: Toolpath, text: str, name: str) -> ProgramLines:
+    """The timed lines of a parsed program ``tp`` whose source is ``text``, named ``name``."""
+    text = text.split("\n")
     g28 = [i for i, s in enumerate(text, 1) if _G28.search(_COMMENT.sub("", s.upper()))]
     ev = tp.events
     m = ev[ev["word"] == "M"]
@@ -96,8 +101,8 @@ def program_lines(path: str | Path) -> tuple[ProgramLines, Toolpath]:
     is_cut = np.isin(tp.kind, (1, 2, 3))
     first_cut = int(tp.line[is_cut][0]) if is_cut.any() else 0
     m30 = m["line"][np.isin(m["value"], (2, 30))]
-    lines = ProgramLines(
-        path.name,
+    return ProgramLines(
+        name,
         first_cut,
         int(m30[0]) if m30.size else int(tp.line.max(initial=0)) + 1,
         changes_arr,
@@ -105,7 +110,6 @@ def program_lines(path: str | Path) -> tuple[ProgramLines, Toolpath]:
         np.array(speeds, float),
         np.asarray(stops[~inside], np.int64),
     )
-    return lines, tp
 
 
 def span_s(block_t_s: np.ndarray, block: np.ndarray, first: int, last: int) -> float:

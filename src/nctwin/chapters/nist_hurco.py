@@ -39,7 +39,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -53,8 +52,6 @@ from ..calibrate import (
     run_overrides,
     sequence_s,
 )
-from ..estimate import cycle_time
-from ..gcode import parse
 from ..identify import identified_block_overlap
 from ..mtconnect import REASONS, nist_runs_table
 from ..report.conditions import Condition
@@ -62,7 +59,6 @@ from ..report.tables import Claim, load_paper_table
 from ..runtimes import machine_runs, motion_window
 from . import nist_learned
 from .nist_learned import _nist_runs
-from .your_program import ProgramResult, block_feeds, run_program
 
 __all__ = [
     "ANALYTIC_METHODS",
@@ -88,7 +84,6 @@ __all__ = [
     "seed_pivot",
     "split_table",
     "verdict_counts",
-    "your_program",
 ]
 
 #: The machines of the shipped logs, by the name in their files.
@@ -528,73 +523,3 @@ def plot_move_feeds(feeds: pd.DataFrame, ax, moves: slice) -> None:
     ax.set_ylabel("average feed per move (mm/s)")
     ax.set_yscale("log")
     ax.legend(loc="lower right", fontsize=8)
-
-
-#: The methods :func:`your_program` runs, by the profile's method names (``None``: each fold's
-#: calibrated choice).
-YOUR_METHODS = {"calibrated": None, "block_overlap": "block_overlap", "cam": "cam"}
-
-
-def your_program(path, table: pd.DataFrame) -> ProgramResult:
-    """A reader's program on each Hurco as ``nctwin estimate`` predicts it with the chapter's
-    calibrations, with the chapter's interval; no truth (neither machine ran it).
-
-    Each fold of :func:`method_rows` (a calibration on the machine's logs with one program held
-    out) predicts the program as its profile does (:meth:`nctwin.calibrate.Calibration.profile`,
-    :func:`nctwin.estimate.cycle_time`, rapid and feed at 100 %): the calibrated choice, Lee et
-    al.'s block overlap with the fold's constants, and CAM; the table shows the median over the
-    folds. The calibrated estimate's interval is :func:`interval_table`'s for a program no fold
-    held out: half-width the largest absolute error of the machine's held-out programs,
-    nominal :math:`n/(n+1)` with :math:`n` programs (where the errors are exchangeable).
-
-    Parameters
-    ----------
-    path : str or path-like
-        A G-code file.
-    table : pandas.DataFrame
-        :func:`held_out_table`, for the interval.
-
-    Returns
-    -------
-    ProgramResult
-        ``times``: a row per machine, time (``motion``, from the first spindle start to the
-        last stop, where the program starts the spindle; ``cycle``) and method:
-        ``predicted_s``, and for the calibrated estimate ``low_s``, ``high_s``,
-        ``half_width_pct``, ``nominal_pct``. ``feeds``: the calibrated estimate's average feed
-        per G-line on each machine (the median fold's).
-    """
-
-    def method(text: str, source: str) -> ProgramResult:
-        tp = parse(text, source=source)
-        rows, block_s = [], {}
-        for name in MACHINES:
-            _, cals = _held_out(name)
-            held = table[(table["machine"] == name) & (table["method"] == "calibrated")]
-            for label, m in YOUR_METHODS.items():
-                cts = [cycle_time(tp, cal.profile(m)) for cal in cals.values()]
-                cycle = np.array([ct.cycle_time_s for ct in cts])
-                median = cts[int(np.argsort(cycle)[len(cycle) // 2])]
-                if label == "calibrated":
-                    block_s[f"{name}_mm_s"] = median.estimate.block_times_s
-                for kind, err, values in (
-                    ("motion", "error_pct", [ct.motion_time_s for ct in cts]),
-                    ("cycle", "cycle_error_pct", cycle),
-                ):
-                    if any(v is None for v in values):
-                        continue
-                    p = float(np.median(values))
-                    row = {"machine": name, "time": kind, "method": label, "predicted_s": p}
-                    if label == "calibrated":
-                        w = float(held[err].abs().max())
-                        row |= {"low_s": p * (1 - w / 100), "high_s": p * (1 + w / 100),
-                                "half_width_pct": w,
-                                "nominal_pct": 100 * len(held) / (len(held) + 1)}  # fmt: skip
-                    rows.append(row)
-        notes = ("No truth: neither Hurco ran this program. The learned methods are not run on "
-                 "it: their networks are trained per held-out program on the logs' tool "
-                 "sections, for the chapter's table.",)  # fmt: skip
-        times = pd.DataFrame(rows).sort_values(["time", "machine"], kind="stable")
-        return ProgramResult(Path(source).name, times.reset_index(drop=True),
-                             block_feeds(tp.lengths_mm, block_s), notes)  # fmt: skip
-
-    return run_program(path, method)

@@ -56,6 +56,7 @@ from ..calibrate import axis_rapid_mm_s, base_machine, run_overrides
 from ..controls import PlannerControl
 from ..estimate.learned import (
     BILSTM_CONFIG,
+    FEATURES,
     MoveData,
     axis_nn_move_times,
     bilstm_move_times,
@@ -70,6 +71,7 @@ from ..runner import run_tasks
 from ..runtimes import ProgramLines, RunTimes, logged_runs, motion_window
 from ..toolpath import Toolpath
 from .nist_targets import axis_targets, block_spans, non_motion_lines, span_targets
+from .your_program import domain_notes
 
 __all__ = [
     "CONTROL",
@@ -575,3 +577,43 @@ def move_feeds(
     frame = pd.DataFrame(out)
     frame.attrs.update(log=run.log, measured_s=run.measured_s)
     return frame
+
+
+def program_times(
+    machine_name: str, tp: Toolpath, window: np.ndarray, seeds: Sequence[int] = (0, 1, 2, 3, 4)
+) -> tuple[dict[tuple[str, str], float], tuple[str, ...]]:
+    """A reader's program as every fold's networks predict it, never retrained for it.
+
+    Parameters
+    ----------
+    machine_name : str
+    tp : Toolpath
+        The program (N blocks).
+    window : ndarray of bool, shape (N,)
+        The blocks the networks time (:func:`nctwin.runtimes.motion_window`: the first cut to
+        the M30); features at rapid and feed 100 % on the fold's machine (:data:`CONTROL`).
+
+    Returns
+    -------
+    times : dict
+        ``(held-out program, method)`` to the networks' own time of the window's moves (s, no
+        floor, no dwell), the mean of ``seeds``' (the ensemble, as :func:`learned_predictions`'
+        rows are averaged in the chapter's table); empty where the window has no move.
+    notes : tuple of str
+        :func:`~nctwin.chapters.your_program.domain_notes` of the moves' features against every
+        fold's training moves.
+    """
+    folds, models = train_folds(machine_name, seeds)
+    times, x = {}, None
+    for fold in folds:
+        machine = base_machine(machine_name, fold.rapid_mm_s)
+        data = move_data(fold.program, tp.take(window), machine, CONTROL)
+        if not len(data.moves):
+            return {}, ()
+        x = data.features
+        for method in METHODS:
+            each = [_move_times(method, models[(fold.program, method, s)][0], data).sum()
+                    for s in seeds]  # fmt: skip
+            times[(fold.program, method)] = float(np.mean(each))
+    train = np.concatenate([p.features for f in folds for p in f.pieces])
+    return times, domain_notes(x, train, FEATURES, rows=f"moves, {machine_name}")
