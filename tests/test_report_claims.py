@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin.report.claims import format_claim, report_claims
+from nctwin.report.claims import bootstrap_interval, format_claim, report_claims, with_seeds
 from nctwin.report.conditions import (
     CONDITION_COLUMNS,
     Condition,
@@ -112,3 +113,32 @@ def test_report_conditions_writes_the_csv_and_refuses_repeated_ids(tmp_path, cap
     assert "4993" in capsys.readouterr().out
     with pytest.raises(ValueError, match=r"condition ids repeat: \['lines'\]"):
         report_conditions("nb", [c, c], results_dir=tmp_path)
+
+
+def test_with_seeds_counts_the_single_networks_that_pass(tmp_path, capsys):
+    claim = with_seeds(Claim("e", "error within 3 %", 2.0, "<", 3.0), [1.0, 4.0, 2.9, float("nan")],
+                       (1.5, 2.5))  # fmt: skip
+    assert (claim.seeds_passing, claim.seeds, claim.interval) == (2, 4, (1.5, 2.5))
+    report_claims("s", [claim], results_dir=tmp_path)
+    record = json.loads((tmp_path / "s" / "claims.json").read_text())[0]
+    assert (record["seeds_passing"], record["seeds"], record["interval"]) == (2, 4, [1.5, 2.5])
+    assert "[2 of 4 single networks pass]" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("passing, seeds", [(3, 2), (-1, 2), (1, None)])
+def test_seed_counts_out_of_range_are_refused(passing, seeds):
+    with pytest.raises(ValueError, match="seeds_passing"):
+        Claim("e", "t", 1.0, "<", 2.0, seeds_passing=passing, seeds=seeds)
+
+
+def test_bootstrap_interval_of_the_mean_by_hand():
+    # every resample of identical seeds gives the same mean: a point interval
+    assert bootstrap_interval(np.full(5, 2.0), np.mean) == (2.0, 2.0)
+    # two seeds 0 and 10: resampled means are 0, 5 or 10 with probabilities 1/4, 1/2, 1/4
+    low, high = bootstrap_interval(np.array([0.0, 10.0]), np.mean, level=0.4)
+    assert (low, high) == (5.0, 5.0)
+    low, high = bootstrap_interval(np.array([0.0, 10.0]), np.mean, level=0.98)
+    assert (low, high) == (0.0, 10.0)
+    # the same seed, the same interval
+    x = np.arange(7.0)
+    assert bootstrap_interval(x, np.mean, seed=3) == bootstrap_interval(x, np.mean, seed=3)

@@ -18,23 +18,25 @@ are); ``table=True`` prints the claims as a table instead, one row per
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .conditions import Condition
-from .tables import Claim, format_table, write_claims
+from .tables import OPS, Claim, format_table, write_claims
 
 __all__ = [
     "LINE",
     "NOT_TESTED",
     "VERDICTS",
     "Claim",
+    "bootstrap_interval",
     "claims_by_seed",
     "format_claim",
     "report_claims",
+    "with_seeds",
 ]
 
 #: The line printed per claim: ``str.format`` fields ``verdict``, ``id``, ``text``, ``value``,
@@ -65,6 +67,10 @@ def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VER
     verdict = NOT_TESTED if claim.unmet else verdicts[0] if claim.holds else verdicts[1]
     text = line.format(verdict=verdict, id=claim.id, text=claim.text, value=claim.value,
                        op=claim.op, threshold=claim.threshold)  # fmt: skip
+    if claim.interval is not None:
+        text += f"  [interval {claim.interval[0]:.3g} to {claim.interval[1]:.3g}]"
+    if claim.seeds is not None:
+        text += f"  [{claim.seeds_passing} of {claim.seeds} single networks pass]"
     return text + (f"  [unmet: {', '.join(claim.unmet)}]" if claim.unmet else "")
 
 
@@ -150,3 +156,51 @@ def claims_by_seed(ensemble: list[Claim], per_seed: dict[int, list[Claim]]) -> p
                      "seed_std": values.std(ddof=1) if len(values) > 1 else np.nan,
                      "seeds_holding": sum(per_seed[s][k].holds for s in per_seed)})  # fmt: skip
     return pd.DataFrame(rows)
+
+
+def bootstrap_interval(
+    per_seed: np.ndarray,
+    statistic: Callable[[np.ndarray], float],
+    *,
+    level: float = 0.9,
+    n_boot: int = 2000,
+    seed: int = 0,
+) -> tuple[float, float]:
+    """Percentile bootstrap interval of an ensemble's statistic over its seeds.
+
+    Parameters
+    ----------
+    per_seed : ndarray, shape (n, ...)
+        Each seed's predictions (row k: seed k's).
+    statistic : callable
+        Maps an array of rows (shape (n, ...), seeds drawn with replacement) to the claim's
+        value for their ensemble, e.g. the error of their mean prediction.
+    level : float
+        Coverage, in (0, 1).
+    n_boot : int
+        Resamples.
+    seed : int
+        Seed of the resampling (``numpy.random.default_rng``).
+
+    Returns
+    -------
+    tuple of float
+        ``(low, high)``: the ``(1 - level) / 2`` and ``(1 + level) / 2`` quantiles of the
+        statistic over the resamples.
+    """
+    per_seed = np.asarray(per_seed, dtype=float)
+    draws = np.random.default_rng(seed).integers(0, len(per_seed), (n_boot, len(per_seed)))
+    values = np.array([statistic(per_seed[d]) for d in draws])
+    low, high = np.quantile(values, [(1 - level) / 2, (1 + level) / 2])
+    return float(low), float(high)
+
+
+def with_seeds(
+    claim: Claim, seed_values: Sequence[float], interval: tuple[float, float] | None = None
+) -> Claim:
+    """``claim`` (judged on an ensemble) with how many single networks pass it, from each seed's
+    own value (``seed_values``, one per seed, in the claim's unit), and ``interval``."""
+    passing = sum(bool(OPS[claim.op](float(v), claim.threshold)) for v in seed_values
+                  if not np.isnan(v))  # fmt: skip
+    return dataclasses.replace(claim, seeds_passing=passing, seeds=len(seed_values),
+                               interval=interval)  # fmt: skip

@@ -426,11 +426,18 @@ class Claim:
     unmet
         Those of ``requires`` that are unmet (set by
         :func:`~nctwin.report.claims.report_claims` from the chapter's conditions).
+    seeds_passing, seeds
+        For a learned claim judged on an ensemble: how many of the ``seeds`` single networks
+        pass the claim on their own ("k of n"); None elsewhere.
+    interval
+        For a learned claim: a bootstrap interval of ``value`` over the seeds
+        (:func:`~nctwin.report.claims.bootstrap_interval`), ``(low, high)``; None elsewhere.
 
     Raises
     ------
     ValueError
-        If ``op`` is not one of :data:`OPS`, or ``whose`` not one of :data:`WHOSE`.
+        If ``op`` is not one of :data:`OPS`, ``whose`` not one of :data:`WHOSE`, or
+        ``seeds_passing`` outside 0 to ``seeds``.
     """
 
     id: str
@@ -441,12 +448,24 @@ class Claim:
     whose: str = "paper"
     requires: tuple[str, ...] = ()
     unmet: tuple[str, ...] = ()
+    seeds_passing: int | None = None
+    seeds: int | None = None
+    interval: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.op not in OPS:
             raise ValueError(f"op must be one of {list(OPS)}, got {self.op!r}")
         if self.whose not in WHOSE:
             raise ValueError(f"whose = {self.whose!r} is out of range: allowed {', '.join(WHOSE)}")
+        if (self.seeds_passing is None) != (self.seeds is None) or (
+            self.seeds is not None and not 0 <= self.seeds_passing <= self.seeds
+        ):
+            raise ValueError(
+                f"claim {self.id!r}: seeds_passing = {self.seeds_passing!r} is out of range: "
+                f"allowed 0 to seeds ({self.seeds!r}), both set or neither"
+            )
+        if self.interval is not None:
+            object.__setattr__(self, "interval", tuple(float(v) for v in self.interval))
         object.__setattr__(self, "value", float(self.value))
         object.__setattr__(self, "threshold", float(self.threshold))
         object.__setattr__(self, "requires", tuple(self.requires))
@@ -469,7 +488,8 @@ class Claim:
 
     def to_dict(self) -> dict[str, Any]:
         """Return the JSON record ``{"id", "text", "value", "op", "threshold", "holds", "whose",
-        "status"}``, and ``"unmet"`` (the unmet conditions' ids) where there are any.
+        "status"}``, and ``"unmet"`` (the unmet conditions' ids) where there are any,
+        ``"seeds_passing"`` and ``"seeds"``, and ``"interval"`` (``[low, high]``) where set.
 
         NaN numbers become ``None`` (JSON ``null``), since JSON has no NaN.
         """
@@ -485,6 +505,10 @@ class Claim:
         }
         if self.unmet:
             out["unmet"] = list(self.unmet)
+        if self.seeds is not None:
+            out |= {"seeds_passing": self.seeds_passing, "seeds": self.seeds}
+        if self.interval is not None:
+            out["interval"] = list(self.interval)
         return out
 
 

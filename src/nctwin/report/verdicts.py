@@ -171,6 +171,17 @@ STATUSES = (
 )
 
 
+def _ours(record: dict) -> str:
+    """The value, and for a learned claim the interval and how many single networks pass."""
+    text = _number(record["value"])
+    if "interval" in record:
+        low, high = record["interval"]
+        text += f" ({_number(low)} to {_number(high)})"
+    if "seeds" in record:
+        text += f"; {record['seeds_passing']} of {record['seeds']} nets pass"
+    return text
+
+
 def _status(record: dict) -> str:
     """A record's status; records written before claims had one give holds or fails."""
     return record.get("status") or ("holds" if record["holds"] else "fails")
@@ -240,7 +251,9 @@ def render(chapters: list[ChapterClaims]) -> str:
         "",
         "Each row: the claim, whose it is, the value the paper reports where the claim quotes "
         "one, ours, the bar (our value against the threshold), the verdict and the section of "
-        "the chapter that explains it. A claim that fails is kept and explained there.",
+        "the chapter that explains it. A claim that fails is kept and explained there. A "
+        "learned claim is judged on the ensemble of its seeds' networks; beside its value, a "
+        "bootstrap interval over the seeds and how many single networks pass on their own.",
     ]
     for chapter in chapters:
         lines += [
@@ -260,7 +273,7 @@ def render(chapters: list[ChapterClaims]) -> str:
             )
             lines.append(
                 f"| {_cell(r['text'])} (`{_cell(r['id'])}`) | {r.get('whose', 'paper')} "
-                f"| {_cell(paper_value(r))} | {_number(r['value'])} "
+                f"| {_cell(paper_value(r))} | {_ours(r)} "
                 f"| {r['op']}&nbsp;{_number(r['threshold'])} | {verdict} "
                 f"| [{_cell(heading)}]({target}) |"
             )
