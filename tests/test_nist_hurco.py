@@ -61,18 +61,27 @@ def test_claims_read_the_papers_bars_and_count_single_networks():
     bars = nh.paper_bars()
     assert bars["block_overlap"] == pytest.approx(1.0)  # Lee: 99 % or more
     errors = {("A", "p1"): 0.5, ("A", "p2"): -0.9}
-    table = pd.concat([_table(errors, m) for m in ("calibrated", "block_overlap")]
-                      + [_table({k: 0.99 * bars[m] for k in errors}, m)
-                         for m in ("bilstm", "axis_nn")])  # fmt: skip
-    seeds = pd.DataFrame([{"machine": "A", "program": p, "method": m, "seed": s,
-                           "within_bar": s < 3 or p == "p1"}
-                          for m in ("bilstm", "axis_nn") for s in range(5)
-                          for p in ("p1", "p2")])  # fmt: skip
-    claims = {c.id: c for c in nh.claims(table, seeds)}
+    table = pd.concat([_table(errors, m) for m in ("calibrated", "block_overlap")])
+    # five seeds of one run per program, measured 100 s: seed s misses by (s - 2) * 0.6 bar %,
+    # so seeds 1-3 are within the bar (-0.6, 0, 0.6 of it) and the ensemble is exact
+    rows = pd.DataFrame([{"machine": "A", "program": p, "method": m, "log": p, "seed": s,
+                          "measured_s": 100.0, "predicted_s": 100 + (s - 2) * 0.6 * bars[m],
+                          "measured_cycle_s": 100.0, "predicted_cycle_s": 100.0,
+                          "epochs": 1, "converged": True}
+                         for m in ("bilstm", "axis_nn") for s in range(5)
+                         for p in ("p1", "p2")])  # fmt: skip
+    table = pd.concat([table, nh.held_out_table(rows)], ignore_index=True)
+    seeds = nh.learned_seed_table(rows, bars)
+    claims = {c.id: c for c in nh.claims(table, seeds, rows)}
     assert claims["block_overlap_real_machine"].holds
     assert claims["block_overlap_real_machine"].value == pytest.approx(0.9)
-    assert claims["bilstm_real_machine"].holds and claims["axis_nn_real_machine"].holds
-    assert claims["bilstm_single_networks"].value == 3.0  # seeds 0-2 hold on both programs
+    bilstm = claims["bilstm_real_machine"]
+    assert bilstm.holds and bilstm.value == pytest.approx(0.0)
+    assert (bilstm.seeds_passing, bilstm.seeds) == (3, 5)
+    # a resample's ensemble errs by the mean of its draws: 0 to 1.2 bar
+    low, high = bilstm.interval
+    assert 0.0 <= low <= high <= 1.2 * bars["bilstm"]
+    assert claims["axis_nn_real_machine"].seeds_passing == 3
     assert claims["calibrated_cycle_2pct"].holds
 
 
@@ -94,3 +103,20 @@ def test_the_repeatability_floor_is_a_fraction_of_a_percent():
     assert set(floor.program.str.contains("BOX")) == {True} and (floor.runs >= 10).all()
     assert (floor.range_motion_pct < 0.2).all()
     assert np.isfinite(floor.sd_cycle_s).all()
+
+
+def test_the_bootstrap_statistic_is_the_claimed_value():
+    # two runs of p1 and one of p2, three seeds, uneven predictions
+    rows = pd.DataFrame([{"machine": "A", "program": p, "method": "bilstm", "log": log,
+                          "seed": s, "measured_s": m, "predicted_s": m + d + s * k,
+                          "measured_cycle_s": m, "predicted_cycle_s": m}
+                         for p, log, m, d, k in (("p1", "r1", 100.0, 3.0, 1.0),
+                                                 ("p1", "r2", 104.0, -1.0, 2.0),
+                                                 ("p2", "r3", 50.0, 2.0, -0.5))
+                         for s in range(3)])  # fmt: skip
+    per_seed, worst = nh._ensemble_worst(rows)
+    assert per_seed.shape == (3, 3)
+    table = nh.held_out_table(rows)
+    assert worst(per_seed) == pytest.approx(table.error_pct.abs().max())
+    # p2: 50 + 2 - 0.5 = 51.5 s on the mean seed, 3 %; p1: runs 104 and 105 s, measured 102
+    assert worst(per_seed) == pytest.approx(3.0)
