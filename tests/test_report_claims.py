@@ -142,3 +142,15 @@ def test_bootstrap_interval_of_the_mean_by_hand():
     # the same seed, the same interval
     x = np.arange(7.0)
     assert bootstrap_interval(x, np.mean, seed=3) == bootstrap_interval(x, np.mean, seed=3)
+
+
+def test_in_a_notebook_the_chapter_status_is_glued(tmp_path, monkeypatch, capsys):
+    import IPython
+    import myst_nb
+
+    glued = {}
+    monkeypatch.setattr(IPython, "get_ipython", lambda: object())
+    monkeypatch.setattr(myst_nb, "glue", lambda name, value, display: glued.update({name: value}))
+    report_claims("s", CLAIMS[:2], results_dir=tmp_path)
+    assert glued == {"chapter_status": "partly reproduced",
+                     "chapter_status_why": "1 of the paper's 2 claims hold, 1 fail."}  # fmt: skip

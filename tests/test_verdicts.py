@@ -141,3 +141,27 @@ def test_a_learned_claim_shows_its_interval_and_single_networks():
     record = {"value": 2.5, "interval": [1.25, 3.5], "seeds_passing": 3, "seeds": 5}
     assert verdicts._ours(record) == "2.5 (1.25 to 3.5); 3 of 5 nets pass"
     assert verdicts._ours({"value": None}) == "-"
+
+
+def test_the_intro_status_is_rewritten_between_its_markers():
+    begin, end = verdicts.INTRO_MARKERS
+    text = f"# Intro\n\nbefore\n{begin}\n- stale line\n{end}\nafter\n"
+    out = verdicts.update_intro(text, ["- one", "- two"])
+    assert out == f"# Intro\n\nbefore\n{begin}\n- one\n- two\n{end}\nafter\n"
+    assert verdicts.update_intro(out, ["- one", "- two"]) == out
+    with pytest.raises(ValueError, match="markers"):
+        verdicts.update_intro("no markers", [])
+
+
+def test_main_writes_the_intro_status(book, tmp_path, monkeypatch):
+    monkeypatch.setattr(verdicts.paths, "repo_root", lambda: book)
+    monkeypatch.setenv("NCTWIN_RESULTS", str(book / "results"))
+    (book / "book").mkdir()
+    (book / "book" / "_toc.yml").write_text((book / "_toc.yml").read_text())
+    begin, end = verdicts.INTRO_MARKERS
+    (tmp_path / "intro.md").write_text(f"# Intro\n{begin}\n{end}\n")
+    verdicts.main([str(tmp_path / "verdicts.md")])
+    lines = (tmp_path / "intro.md").read_text().splitlines()
+    assert lines[0] == "# Intro" and lines[1] == begin and lines[-1] == end
+    assert len(lines) == 2 + 2 + 1  # a line per chapter of the fixture (two)
+    assert all(ln.startswith("- **[") for ln in lines[2:4])

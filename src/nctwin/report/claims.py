@@ -7,7 +7,9 @@ Every chapter ends with one call,
     report_claims(STEM, chapter.claims(...));
 
 where ``chapter.claims`` builds the chapter's :class:`~nctwin.report.tables.Claim` list from its
-tables. A failing claim is reported (``FAILS``), never asserted away.
+tables. A failing claim is reported (``FAILS``), never asserted away. In a notebook, the call
+also glues the chapter's status and why (``chapter_status``, ``chapter_status_why``: the
+Verdicts page's, :func:`nctwin.report.verdicts.status_of`), which the chapter's opening shows.
 
 The printed line is :data:`LINE` with :data:`VERDICTS` unless a chapter keeps its own (the
 chapters were written with slightly different lines, and their checked outputs stay as they
@@ -26,6 +28,7 @@ import pandas as pd
 
 from .conditions import Condition
 from .tables import OPS, Claim, format_table, write_claims
+from .verdicts import status_of
 
 __all__ = [
     "LINE",
@@ -122,11 +125,27 @@ def report_claims(
     claims = [dataclasses.replace(c, unmet=tuple(r for r in c.requires if not met[r]))
               for c in claims]  # fmt: skip
     write_claims(stem, claims, results_dir=results_dir)
+    _glue_status(claims)
     if table:
         print(format_table(pd.DataFrame([c.to_dict() for c in claims])))
     else:
         for c in claims:
             print(format_claim(c, line, verdicts))
+
+
+def _glue_status(claims: list[Claim]) -> None:
+    """In a notebook, glue the chapter's status and why (:func:`~nctwin.report.verdicts.
+    status_of`) as ``chapter_status`` and ``chapter_status_why``, for the chapter's opening
+    (``{glue:text}`chapter_status```); nothing outside a kernel."""
+    from IPython import get_ipython
+
+    if get_ipython() is None:
+        return
+    from myst_nb import glue
+
+    status, why = status_of([c.to_dict() for c in claims])
+    glue("chapter_status", status, display=False)
+    glue("chapter_status_why", why, display=False)
 
 
 def claims_by_seed(ensemble: list[Claim], per_seed: dict[int, list[Claim]]) -> pd.DataFrame:
