@@ -430,3 +430,27 @@ def test_auto_reports_the_reader(linuxcnc_interpreter):
     np.testing.assert_allclose(result.toolpath.end_mm, [[2, 0, 0]])
     with pytest.raises(GCodeError, match="axis A is not supported"):
         read("G0 X1 A2")  # the native reader refuses rotary axes itself: its error stands
+
+
+def test_a_tool_table_is_completed_only_where_no_size_is_needed():
+    table = "T1 P1 D0 Z0 ;\nT5 P7 D6 Z1 ;\n"
+    # T2 and T9 are added after the largest pocket (7), of size 0; T0 and T1 are not
+    assert _interp.complete_tool_table(table, "T2 M6\nT0\n(T3 in a comment)\nT1 G1 X1\nT9\n") == (
+        table + "T2 P8 D0 Z0 ;not in the table\nT9 P9 D0 Z0 ;not in the table\n"
+    )
+    # cutter compensation or a length offset needs the table's sizes: nothing is added
+    for code in ("G41 D2", "G42", "G43 H2", "G43.2 H2", "G041"):
+        assert _interp.complete_tool_table(table, f"T2 M6\n{code} G1 X1\n") == table
+    # dynamic compensation and offsets carry their size in the block; GT is an operator
+    for code in ("G41.1 D4", "G43.1 Z2", "O100 if [#1 GT 2]"):
+        assert _interp.complete_tool_table(table, f"T2 M6\n{code}\n") != table
+    assert _interp.complete_tool_table("T1 P1 D0 Z0 ;", "T2") == (
+        "T1 P1 D0 Z0 ;\nT2 P2 D0 Z0 ;not in the table\n"
+    )
+
+
+def test_linuxcnc_reads_a_tool_its_table_lacks(linuxcnc_interpreter):
+    tp = parse("G21 G90 F600\nT4 M6\nG1 X10\nM2\n", reader="linuxcnc")
+    assert tp.end_mm[-1].tolist() == [10.0, 0.0, 0.0]
+    with pytest.raises(GCodeError, match=r"Requested tool 4 not found.*G41, G42, G43"):
+        parse("G21 G90 F600\nT4 M6\nG41 D4 G1 X10 Y5\nG1 X20\nM2\n", reader="linuxcnc")

@@ -94,9 +94,11 @@ LinuxCNC's own rs274ngc interpreter (``make linuxcnc`` installs it; see
 :mod:`nctwin.gcode._interp`), which reads the whole language and gives the moves LinuxCNC runs,
 as the same :class:`~nctwin.toolpath.Toolpath`; it takes a LinuxCNC tool table
 (``tool_table=``, default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC
-configuration). ``"auto"`` is the native reader, and where that refuses only constructs that need
-the interpreter, the interpreter if :func:`interpreter_available`; otherwise the native error
-stands. The two agree to 1e-6 mm on every program both read (``tests/test_gcode_interp.py``).
+configuration); a tool the table lacks runs with size 0 unless the program's cutter
+compensation or length offset needs its size (:func:`complete_tool_table`). ``"auto"`` is the
+native reader, and where that refuses only constructs that need the interpreter, the
+interpreter if :func:`interpreter_available`; otherwise the native error stands. The two agree
+to 1e-6 mm on every program both read (``tests/test_gcode_interp.py``).
 
 To learn which reader read a program, call :func:`read` or :func:`read_file`: they return a
 :class:`ReadResult` with ``toolpath`` and ``reader`` (``"native"`` or ``"linuxcnc"``)::
@@ -114,7 +116,7 @@ from ._interp import LINUXCNC_TOOL_TABLE as LINUXCNC_TOOL_TABLE
 from ._interp import MAX_MOVES as MAX_MOVES
 from ._interp import TIMEOUT_BASE_S as TIMEOUT_BASE_S
 from ._interp import TIMEOUT_S_PER_MB as TIMEOUT_S_PER_MB
-from ._interp import interpreter_available
+from ._interp import complete_tool_table, interpreter_available
 from ._modal import MAX_BLOCKS_PER_LINE as MAX_BLOCKS_PER_LINE
 from ._modal import MM_PER_INCH as MM_PER_INCH
 from ._reader import read_text
@@ -124,6 +126,7 @@ from ._select import ReadResult, parse, parse_file, read, read_file
 __all__ = [
     "GCodeError",
     "ReadResult",
+    "complete_tool_table",
     "dump",
     "interpreter_available",
     "parse",

@@ -270,11 +270,11 @@ def read_linuxcnc(
     with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:
         program = Path(tmp) / "program.ngc"
         program.write_text(_instrument(text.replace("\r\n", "\n").replace("\r", "\n")))
-        table = Path(tool_table) if tool_table is not None else Path(tmp) / "tool.tbl"
-        if tool_table is None:
-            table.write_text(LINUXCNC_TOOL_TABLE)
-        elif not table.is_file():
-            raise GCodeError(0, "", f"tool table {table} not found", source)
+        if tool_table is not None and not Path(tool_table).is_file():
+            raise GCodeError(0, "", f"tool table {tool_table} not found", source)
+        given = LINUXCNC_TOOL_TABLE if tool_table is None else Path(tool_table).read_text()
+        table = Path(tmp) / "tool.tbl"
+        table.write_text(complete_tool_table(given, text))
         job = {
             "program": str(program),
             "tool_table": str(table.resolve()),
@@ -298,6 +298,41 @@ def read_linuxcnc(
             _error_line(error, events), "", _reason(error[1], name, program, folder), source
         )
     return _toolpath(moves, events, modal, source)
+
+
+#: Comments, ``<names>`` of parameters and subroutines, and the words of a program's text.
+_NOT_WORDS = re.compile(r"\([^)]*\)|;[^\n]*|<[^>]*>")
+_WORDS = re.compile(r"(?<![A-Z])([GT])\s*(\d+(?:\.\d*)?)", re.IGNORECASE)
+_TABLE_TOOL = re.compile(r"^\s*T(\d+)(?:.*?\bP(\d+))?", re.IGNORECASE | re.MULTILINE)
+#: The G-codes that take a tool's size from the table: cutter compensation (its diameter) and
+#: tool length offsets (its length); G41.1, G42.1 and G43.1 give the size in the block.
+SIZED_CODES = (41.0, 42.0, 43.0, 43.2)
+
+
+def complete_tool_table(table: str, program: str) -> str:
+    """``table`` with each tool the program's T words select and the table lacks, of diameter
+    0 and length 0: a tool's size matters to the path only where cutter compensation or a length
+    offset needs it (:data:`SIZED_CODES`). A program with one of those gets ``table`` as it is,
+    and LinuxCNC refuses a tool it lacks. T0 (no tool) is never added.
+
+    Parameters
+    ----------
+    table : str
+        A LinuxCNC tool table's text (``T<n> P<pocket> D<diameter> Z<length> ;...`` lines).
+    program : str
+        The program's text: literal T and G words outside comments (T words computed from
+        parameters are not seen).
+    """
+    words = _WORDS.findall(_NOT_WORDS.sub(" ", program))
+    if any(k.upper() == "G" and float(v) in SIZED_CODES for k, v in words):
+        return table
+    listed = _TABLE_TOOL.findall(table)
+    missing = sorted({int(float(v)) for k, v in words if k.upper() == "T"} - {0}
+                     - {int(t) for t, _ in listed})  # fmt: skip
+    pocket = max((int(p) for _, p in listed if p), default=0)
+    added = "".join(f"T{t} P{pocket + k} D0 Z0 ;not in the table\n"
+                    for k, t in enumerate(missing, 1))  # fmt: skip
+    return table + ("" if not added or table.endswith("\n") else "\n") + added
 
 
 def _error_line(error: list, events: np.ndarray) -> int:
@@ -421,8 +456,9 @@ def _reason(message: str, name: str, program: Path, folder) -> str:
         )
     if re.match(r"Requested tool \d+ not found in the tool table", message):
         message += (
-            ": give the machine's LinuxCNC tool table (tool_table=, nctwin --tool-table FILE);"
-            " nctwin's own holds T1 only, of diameter 0"
+            ", and the program's cutter compensation or length offset (G41, G42, G43) needs"
+            " the sizes: give the machine's LinuxCNC tool table (tool_table=, nctwin"
+            " --tool-table FILE); nctwin's own holds T1 only, of diameter 0"
         )
     return message
 

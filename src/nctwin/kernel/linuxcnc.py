@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 
 from ..controls import PlannerControl
-from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, dump, parse
+from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, complete_tool_table, dump, parse
 from ..machine import Machine
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
@@ -337,7 +337,8 @@ def record(
         files = {
             "sim.ini": ini,
             "sim.hal": hal_text(),
-            "tool.tbl": LINUXCNC_TOOL_TABLE,  # the interpreter reader's default too
+            # the interpreter reader's default too: its tools and the program's others, of size 0
+            "tool.tbl": complete_tool_table(LINUXCNC_TOOL_TABLE, program),
             "program.ngc": program,
             "display.py": _DISPLAY.read_text(),
         }
