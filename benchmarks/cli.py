@@ -9,6 +9,11 @@ coordinates. Time: the shortest of :data:`REPEAT` runs. Peak memory: the largest
 of the command's process (``getrusage(RUSAGE_CHILDREN).ru_maxrss`` of a fresh process that runs
 only it). Targets: at most 5 s and 1.5 GB each. The CPU time (user and system) of the command
 is recorded too: on a busy machine it says what the wall time would be on an idle one.
+
+The estimate's memory must not grow with the motion's duration: ``raster`` is a 200,000-line
+raster of 0.25 mm moves (:func:`raster_program`), run at F3000 (about 1,100 s of motion on
+``linuxcnc_sim``) and at F80 (about 10.5 hours); each ``nctwin estimate --method kernel`` at most
+1.5 GB.
 """
 
 from __future__ import annotations
@@ -51,6 +56,21 @@ def long_program(passes: int = PASSES) -> str:
     return "\n".join(out) + "\n"
 
 
+def raster_program(feed_mm_min: float, rows: int = 500, moves: int = 400) -> str:
+    """A zig-zag raster of ``rows`` rows of ``moves`` 0.25 mm moves, 0.5 mm apart (G21, G90,
+    ``G64 P0.01``), at ``feed_mm_min``: ``rows * (moves + 1) + 5`` lines."""
+    out = ["G21 G90 G64 P0.01", f"F{feed_mm_min:g}", "G0 X0 Y0 Z1", "G1 Z0"]
+    x, d = 0.0, 1
+    for row in range(rows):
+        for _ in range(moves):
+            x += 0.25 * d
+            out.append(f"G1 X{x:.3f}")
+        out.append(f"G1 Y{0.5 * (row + 1):.3f}")
+        d = -d
+    out.append("M2")
+    return "\n".join(out) + "\n"
+
+
 def measure(args: list[str], repeat: int = REPEAT) -> tuple[float, float, float]:
     """Shortest wall time (s) and CPU time (s) of ``nctwin *args`` over ``repeat`` runs, and
     its peak resident memory (GB)."""
@@ -88,6 +108,13 @@ def main() -> None:
             ).stdout
         )["blocks"]
         record("cli_program_blocks", blocks, "blocks", "")
+        for label, feed in (("1100s", 3000.0), ("10h", 80.0)):
+            raster = Path(tmp) / f"raster_{label}.ngc"
+            raster.write_text(raster_program(feed))
+            args = ["estimate", str(raster), "--machine", "linuxcnc_sim", "--method", "kernel"]
+            t, cpu, peak = measure(args, repeat=1)
+            record(f"cli_estimate_kernel_raster_{label}_s", round(t, 3), "s", "")
+            record(f"cli_estimate_kernel_raster_{label}_peak_gb", round(peak, 3), "GB", "<= 1.5")
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 """The compiled sample loops of the FIR kernel compute the same bits as the numpy they replace."""
 
+import itertools
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -39,6 +41,16 @@ def test_box_cascade_equals_numpy_running_sums(seed, m, taps):
     out_t = np.empty_like(out)
     _fir_loops.box_cascade(np.ascontiguousarray(x.T).T, np.array(taps, dtype=np.int64), out_t)
     np.testing.assert_array_equal(out_t, out)
+    # and so does the input streamed in chunks, the tail flushed at the end
+    t = np.array(taps, dtype=np.int64)
+    total, ring = np.zeros((len(t), 3)), np.empty((len(t), t.max(), 3))
+    count, last = np.zeros(len(t), dtype=np.int64), np.empty((len(t), 3))
+    streamed = np.empty_like(out)
+    cuts = np.unique(np.r_[0, np.sort(rng.integers(0, m, 3)), m])
+    for lo, hi in itertools.pairwise(cuts):
+        _fir_loops.box_stream(x[lo:hi], x[0], t, total, ring, count, last, streamed[lo:hi])
+    _fir_loops.box_flush(x[-1], x[0], t, total, ring, count, last, streamed[m:])
+    np.testing.assert_array_equal(streamed + x[0], out)
     # and so does the input in the first rows of the output, filtered in place
     out_in_place = np.empty_like(out)
     out_in_place[:m] = x
@@ -69,9 +81,14 @@ def test_sample_command_equals_np_interp(seed, k, pauses, infinite):
     out = np.empty((n_cmd, 3))
     t = np.arange(n_cmd) * PERIOD_S
     with np.errstate(invalid="ignore"):
-        _fir_loops.sample_command(n_cmd, PERIOD_S, t_knots, x_knots, out)
+        _fir_loops.sample_command(n_cmd, PERIOD_S, t_knots, x_knots, 0, out)
         expected = np.column_stack([np.interp(t, t_knots, x_knots[:, a]) for a in range(3)])
+        # from any first sample on, the same bits
+        i0 = int(rng.integers(0, n_cmd))
+        part = np.empty((n_cmd - i0, 3))
+        _fir_loops.sample_command(n_cmd - i0, PERIOD_S, t_knots, x_knots, i0, part)
     np.testing.assert_array_equal(out, expected)
+    np.testing.assert_array_equal(part, expected[i0:])
 
 
 def _numpy_derivatives(pos: np.ndarray) -> list[np.ndarray]:
@@ -178,7 +195,11 @@ def test_sample_blocks_equal_numpy_repeat(seed, c, delay):
     kept = np.sort(rng.choice(100, 20, replace=False))
     n = int(np.ceil(t_knots[-1] / PERIOD_S)) + 2 * delay + 1
     out = np.empty(n, dtype=np.int64)
-    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, pause_block, block, kept, out)
+    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, pause_block, block, kept, 0, out)
+    i0 = int(rng.integers(0, n))  # from any first sample on, the same blocks
+    part = np.empty(n - i0, dtype=np.int64)
+    _fir_loops.sample_blocks(t_knots, PERIOD_S, delay, pause_block, block, kept, i0, part)
+    np.testing.assert_array_equal(part, out[i0:])
     # the numpy it replaces: segments' blocks (an unowned pause takes the next segment's,
     # cyclically), repeated over the samples each segment owns
     seg = np.column_stack([pause_block, np.append(block, 0)]).ravel()[:-1]

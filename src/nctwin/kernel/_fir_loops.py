@@ -19,6 +19,8 @@ from .._geometry_loops import path_points
 
 __all__ = [
     "box_cascade",
+    "box_flush",
+    "box_stream",
     "derivative_peaks",
     "filtered_points",
     "knot_times",
@@ -30,20 +32,21 @@ __all__ = [
 
 
 @njit(cache=True)
-def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover - compiled
-    """Positions of a piecewise-linear command at ``i * period_s``, ``i < n_cmd``.
+def sample_command(n_cmd, period_s, t_knots, x_knots, i0, out):  # pragma: no cover - compiled
+    """Positions of a piecewise-linear command at ``(i0 + i) * period_s``, ``i < n_cmd``.
 
     ``t_knots`` (K,) non-decreasing from 0, ``x_knots`` (K, 3); writes ``out`` (n_cmd, 3). The same
     arithmetic as ``np.interp`` per axis (value at a knot exactly, ``slope * (t - t_j) + x_j``
-    inside, the last value at and after the last knot); the knot search walks forward, as the
-    sample times increase. A segment's slopes are computed once, and its samples in one loop
-    without branches; ``np.interp``'s fallbacks where that gives NaN (infinite positions) after.
+    inside, the last value at and after the last knot); the knot search starts where a walk
+    from the first knot would be at sample ``i0`` and walks forward, as the sample times
+    increase. A segment's slopes are computed once, and its samples in one loop without
+    branches; ``np.interp``'s fallbacks where that gives NaN (infinite positions) after.
     """
     k = len(t_knots)
-    j = 0
+    j = max(np.searchsorted(t_knots, i0 * period_s, side="right") - 1, 0)
     i = 0
     while i < n_cmd:
-        t = i * period_s
+        t = (i0 + i) * period_s
         while j + 1 < k and t_knots[j + 1] <= t:
             j += 1
         if j == k - 1:  # at and after the last knot
@@ -61,8 +64,8 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
         sy = (x_knots[j + 1, 1] - y0) / (t1 - t0)
         sz = (x_knots[j + 1, 2] - z0) / (t1 - t0)
         first = i
-        while i < n_cmd and i * period_s < t1:
-            t = i * period_s
+        while i < n_cmd and (i0 + i) * period_s < t1:
+            t = (i0 + i) * period_s
             out[i, 0] = sx * (t - t0) + x0
             out[i, 1] = sy * (t - t0) + y0
             out[i, 2] = sz * (t - t0) + z0
@@ -71,7 +74,7 @@ def sample_command(n_cmd, period_s, t_knots, x_knots, out):  # pragma: no cover 
             for a in range(3):
                 if np.isnan(out[r, a]):
                     slope = (x_knots[j + 1, a] - x_knots[j, a]) / (t1 - t0)
-                    v = slope * (r * period_s - t1) + x_knots[j + 1, a]
+                    v = slope * ((i0 + r) * period_s - t1) + x_knots[j + 1, a]
                     if np.isnan(v) and x_knots[j, a] == x_knots[j + 1, a]:
                         v = x_knots[j, a]
                     out[r, a] = v
@@ -116,6 +119,62 @@ def box_cascade(x, taps, out):  # pragma: no cover - compiled
     for i in range(m):
         for a in range(3):
             out[i, a] += x0[a]
+
+
+@njit(cache=True)
+def _through(v, first, taps, total, ring, count, last):  # pragma: no cover - compiled
+    """Feed ``v`` (3,) to stage ``first`` of a streamed cascade and on through the later
+    stages, in place: each stage ``s`` does what :func:`box_cascade`'s does with its next input
+    (``count[s]`` inputs so far, its running sum ``total[s]`` (3,), its last ``n`` sums in
+    ``ring[s]``), so the outputs are its bits; ``last[s]`` (3,) keeps the stage's output."""
+    for s in range(first, len(taps)):
+        n = taps[s]
+        j = count[s]
+        slot = j % n
+        for a in range(3):
+            c = v[a] if j == 0 else total[s, a] + v[a]
+            total[s, a] = c
+            d = c if j < n else c - ring[s, slot, a]
+            ring[s, slot, a] = c
+            v[a] = d / n
+            last[s, a] = v[a]
+        count[s] = j + 1
+
+
+@njit(cache=True)
+def box_stream(x, x0, taps, total, ring, count, last, out):  # pragma: no cover - compiled
+    """The next ``len(x)`` inputs (m, 3) of :func:`box_cascade`, streamed: writes the same
+    ``len(x)`` outputs to ``out`` (m, 3) (without the final ``+ x0``). ``x0`` (3,) the first
+    input; the state ``total`` (S, 3), ``ring`` (S, max(taps), 3), ``count`` (S,) starts at
+    zero; ``last`` (S, 3) holds each stage's latest output, for :func:`box_flush`."""
+    v = np.empty(3)
+    for i in range(x.shape[0]):
+        for a in range(3):
+            v[a] = x[i, a] - x0[a]
+        _through(v, 0, taps, total, ring, count, last)
+        for a in range(3):
+            out[i, a] = v[a]
+
+
+@njit(cache=True)
+def box_flush(x_last, x0, taps, total, ring, count, last, out):  # pragma: no cover - compiled
+    """The tail of a streamed cascade: each stage in turn is held at its last input (the first
+    stage at ``x_last - x0``, a later one at the earlier stage's last output), ``n - 1`` more
+    inputs each, as :func:`box_cascade` holds them; writes the ``sum(taps) - len(taps)``
+    outputs to ``out`` (without the final ``+ x0``)."""
+    v = np.empty(3)
+    held = np.empty(3)
+    row = 0
+    for s in range(len(taps)):
+        for a in range(3):
+            held[a] = x_last[a] - x0[a] if s == 0 else last[s - 1, a]
+        for _ in range(taps[s] - 1):
+            for a in range(3):
+                v[a] = held[a]
+            _through(v, s, taps, total, ring, count, last)
+            for a in range(3):
+                out[row, a] = v[a]
+            row += 1
 
 
 #: Samples per chunk of the derivative loops (their buffers stay in the first-level cache).
@@ -312,7 +371,7 @@ def _first_sample(t, period_s, delay):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def sample_blocks(  # pragma: no cover - compiled
-    t_knots, period_s, delay, pause_block, block, kept, out
+    t_knots, period_s, delay, pause_block, block, kept, i0, out
 ):
     """Block of each sample, ``out`` (n,), from the blocks of the time segments between knots.
 
@@ -320,14 +379,14 @@ def sample_blocks(  # pragma: no cover - compiled
     ``pause_block[c]`` (C,), or where that is -1 the next segment's (the last pause's: the
     first segment's); segment ``2c + 1`` the move after it, in ``block[c]`` (C - 1,). A segment
     owns the samples from its start's :func:`_first_sample` up to the next segment's (the
-    first segment every sample before that too); ``out[i]`` is ``kept`` of its block. One walk
-    over samples and segments together.
+    first segment every sample before that too); ``out[i]`` is ``kept`` of sample ``i0 + i``'s
+    block. One walk over samples and segments together.
     """
     segments = len(t_knots) - 1
     s = 0
     next_start = _first_sample(t_knots[1], period_s, delay) if segments > 1 else 0
     for i in range(len(out)):
-        while s + 1 < segments and next_start <= i:
+        while s + 1 < segments and next_start <= i0 + i:
             s += 1
             if s + 1 < segments:
                 next_start = _first_sample(t_knots[s + 1], period_s, delay)

@@ -494,7 +494,7 @@ def _interpolate(tp, fir: FirFilter, t_knots, x_knots):
     samples = np.empty((2, n_cmd + lag, 3))
     pos = samples[0]
     x = pos[:n_cmd]  # the command, filtered in place
-    _fir_loops.sample_command(n_cmd, ts, t_knots, np.ascontiguousarray(x_knots), x)
+    _fir_loops.sample_command(n_cmd, ts, t_knots, np.ascontiguousarray(x_knots), 0, x)
     x[0], x[-1] = tp.start_mm[0], tp.end_mm[-1]
     first, last = x[0].copy(), x[-1].copy()
     head = _first_change(x, first)  # samples at rest at the start
@@ -573,6 +573,79 @@ def stand_in(toolpath: Toolpath, control: FirControl) -> tuple[np.ndarray, np.nd
     return feed, tol
 
 
+@dataclass(frozen=True, eq=False)
+class Prepared:
+    """What every pass of the kernel over a tool path shares (:func:`prepare`).
+
+    Parameters
+    ----------
+    fir : FirFilter
+    kept : ndarray of int, shape (M,)
+        The blocks of the tool path the kernel runs (moves of non-zero length and dwells).
+    tp : Toolpath
+        Those blocks (M).
+    cmd : _Command
+        The speed command.
+    limits : ndarray, shape (3, 3)
+        Axis velocity, acceleration and jerk limits (row = order, column = axis).
+    refinement : tuple or None
+        :func:`_arc_refinement`.
+    x_knots : ndarray, shape (K, 3)
+        The path points of the (refined) knots, the same in every pass.
+    """
+
+    fir: FirFilter
+    kept: np.ndarray
+    tp: Toolpath
+    cmd: _Command
+    limits: np.ndarray
+    refinement: tuple | None
+    x_knots: np.ndarray
+
+
+def prepare(toolpath: Toolpath, machine: Machine, control: FirControl) -> Prepared | None:
+    """Plan ``toolpath`` and build its speed command; None where no block moves or dwells."""
+    fir = FirFilter.of(control)
+    # zero-length moves are no-ops: plan without them, report the kept blocks' indices
+    kept = np.flatnonzero(_moves(toolpath) | (toolpath.kind == MotionKind.DWELL))
+    tp = toolpath if len(kept) == len(toolpath) else toolpath.take(kept)
+    if len(tp) == 0:
+        return None
+    geo = PathGeometry(tp)
+    cmd = _command(tp, geo, plan(tp, machine, control, geo=geo), fir)
+    machine = enforced_machine(machine, control)
+    limits = np.array(
+        [
+            machine.axis_max_velocity_mm_s,
+            machine.axis_max_acceleration_mm_s2,
+            machine.axis_max_jerk_mm_s3,
+        ]
+    )
+    # the path points of the knots are the same in every pass: computed once
+    refinement = _arc_refinement(tp, geo, cmd)
+    if refinement is None:
+        x_knots = np.repeat(geo.points(cmd.cuts), 2, axis=0)
+    else:
+        x_knots = geo.points(_refined(cmd.knot_s, refinement))
+    return Prepared(fir, kept, tp, cmd, limits, refinement, x_knots)
+
+
+def slow_down(
+    scale: np.ndarray, t_knots: np.ndarray, bad: np.ndarray, ratio: np.ndarray, lag: int, ts: float
+) -> None:
+    """Lower ``scale`` (C - 1,), the command's speed factors, in place over the windows that made
+    the samples ``bad`` (B,) exceed a limit by ``ratio`` (B,) (``t_knots`` (2C,) of the pass,
+    ``lag`` the filter's lag in samples, ``ts`` the period)."""
+    t_lo = (bad - lag - 3) * ts
+    t_hi = bad * ts
+    move_t0 = t_knots[1::2][:-1]  # start times of the moving intervals
+    i_lo = np.searchsorted(move_t0, t_lo, side="right") - 1
+    i_hi = np.searchsorted(move_t0, t_hi, side="right")
+    factor = _fir_loops.range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio)
+    slow = factor < 1.0
+    scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
+
+
 def run(toolpath: Toolpath, machine: Machine, control: FirControl) -> Motion:
     """Interpolate a tool path on the FIR kernel.
 
@@ -591,53 +664,29 @@ def run(toolpath: Toolpath, machine: Machine, control: FirControl) -> Motion:
         Samples every ``period_s`` from rest at the start to rest at the end, labelled with
         the blocks of ``toolpath``.
     """
-    fir = FirFilter.of(control)
-    ts = fir.period_s
-    # zero-length moves are no-ops: plan without them, report the kept blocks' indices
-    kept = np.flatnonzero(_moves(toolpath) | (toolpath.kind == MotionKind.DWELL))
-    tp = toolpath if len(kept) == len(toolpath) else toolpath.take(kept)
-    if len(tp) == 0:
+    prep = prepare(toolpath, machine, control)
+    if prep is None:
         z = np.zeros((1, 3))
-        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), ts)
-    geo = PathGeometry(tp)
-    cmd = _command(tp, geo, plan(tp, machine, control, geo=geo), fir)
-    machine = enforced_machine(machine, control)
-    limits = np.array(
-        [
-            machine.axis_max_velocity_mm_s,
-            machine.axis_max_acceleration_mm_s2,
-            machine.axis_max_jerk_mm_s3,
-        ]
-    )
-    # the path points of the knots are the same in every pass: computed once
-    refinement = _arc_refinement(tp, geo, cmd)
-    if refinement is None:
-        x_knots = np.repeat(geo.points(cmd.cuts), 2, axis=0)
-    else:
-        x_knots = geo.points(_refined(cmd.knot_s, refinement))
+        return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), control.period_s)
+    fir, cmd, refinement = prep.fir, prep.cmd, prep.refinement
+    ts = fir.period_s
     scale = np.ones(len(cmd.speed))
     for _ in range(MAX_SLOWDOWNS + 1):
         t_knots = cmd.knot_times(scale)
-        samples, lag = _interpolate(tp, fir, _refined(t_knots, refinement), x_knots)
+        samples, lag = _interpolate(prep.tp, fir, _refined(t_knots, refinement), prep.x_knots)
         pos = samples[0]
-        ratio = _limit_ratio(pos, ts, limits)
+        ratio = _limit_ratio(pos, ts, prep.limits)
         if ratio is None:
             break
         # slow the command over the windows that made the violating samples
         bad = np.flatnonzero(ratio > 1.0 + LIMIT_RTOL)
-        t_lo = (bad - lag - 3) * ts
-        t_hi = bad * ts
-        move_t0 = t_knots[1::2][:-1]  # start times of the moving intervals
-        i_lo = np.searchsorted(move_t0, t_lo, side="right") - 1
-        i_hi = np.searchsorted(move_t0, t_hi, side="right")
-        factor = _fir_loops.range_min(len(scale), np.maximum(i_lo, 0), i_hi, 1.0 / ratio[bad])
-        slow = factor < 1.0
-        scale[slow] *= factor[slow] * (1.0 - SLOWDOWN_MARGIN)
+        slow_down(scale, t_knots, bad, ratio[bad], lag, ts)
     vel = samples[1]
     _velocities(pos, ts, vel)
     t = np.arange(len(pos), dtype=np.float64)
     t *= ts
     # block of each sample: the command's block at the centre of the filter window
-    block = np.empty(len(pos), dtype=kept.dtype)
-    _fir_loops.sample_blocks(t_knots, ts, lag // 2, cmd.pause_block, cmd.block, kept, block)
+    block = np.empty(len(pos), dtype=prep.kept.dtype)
+    _fir_loops.sample_blocks(t_knots, ts, lag // 2, cmd.pause_block, cmd.block, prep.kept, 0,
+                             block)  # fmt: skip
     return Motion(t, pos, vel, block, ts)
