@@ -193,3 +193,31 @@ def test_seeds_train_in_parallel_with_the_sequential_bits(tmp_path, monkeypatch)
                 assert torch.equal(v, b.model.state_dict()[k]), (s, axis, k)
     # the seeds differ, the axes differ
     assert not torch.equal(one[0]["X"].model.head.weight, one[1]["X"].model.head.weight)
+
+
+def test_judged_claims_count_single_seeds_and_keep_the_model_claim_without_seeds() -> None:
+    procs = [dk.Process(0, "pocket", "ccw", 10.0, 1.0, 300.0, 2600.0, (0, 0, 0), False, 0, 0,
+                        test=True),
+             dk.Process(1, "ramp", "-y/+z", 10.0, 2.0, 300.0, 2600.0, (0, 0, 0), False, 0, 0,
+                        test=True),
+             dk.Process(2, "side", "+x", 2.0, 1.0, 300.0, 2600.0, (0, 0, 0), True, 50, 0.5,
+                        test=True)]  # fmt: skip
+    rec = SimpleNamespace(processes=procs)
+    targets = np.full((3, 4, 3), 100.0)
+    reversal = np.zeros((3, 4, 3), dtype=bool)
+    reversal[0, :2, 0] = True
+    w = dk.Windows(np.ones((3, 4), dtype=bool), np.ones((3, 4, 3), dtype=bool), reversal)
+    recon = {i: np.full((4, 3), 110.0) for i in range(3)}
+    # seed 0 errs by 2 N everywhere, seed 1 by 6 N: the ensemble by 4 N, the model by 10 N
+    per_seed = {0: {i: np.full((4, 3), 102.0) for i in range(3)},
+                1: {i: np.full((4, 3), 106.0) for i in range(3)}}  # fmt: skip
+    paper = load_paper_table("denkena2020_summary")
+    judged, by_seed = dc.judged_claims(rec, targets, per_seed, recon, w, paper)
+    c = {x.id: x for x in judged}
+    assert c["lstm_lower_at_least"].value == pytest.approx(60.0)  # 1 - 4/10
+    assert (c["lstm_lower_at_most"].seeds_passing, c["lstm_lower_at_most"].seeds) == (0, 2)
+    low, high = c["lstm_lower_at_least"].interval
+    assert 40.0 - 1e-9 <= low <= high <= 80.0 + 1e-9  # between seed 1's and seed 0's alone
+    assert c["reversal_model_fails"].seeds is None
+    row = by_seed.set_index("id").loc["lstm_lower_at_least"]
+    assert (row.seed_0, row.seed_1) == pytest.approx((80.0, 40.0))
