@@ -190,3 +190,31 @@ def test_seed_runs_score_each_seed_and_their_mean() -> None:
     ens = table.iloc[-1]
     assert ens.test_mse == pytest.approx(np.mean(((mean - y[:, 0]) / 2.0) ** 2))
     assert ens.max_abs_err_um == pytest.approx(np.abs(mean - y[:, 0]).max())
+
+
+def test_conditions_compare_each_surface_with_the_papers_row() -> None:
+    from nctwin.chapters import zhang2023_claims as zc
+
+    cc = np.zeros((2, 3, 3))
+    cc[..., 0] = [0.0, 60.0, 120.0]
+    cc[..., 1] = np.array([0.0, 140.0])[:, None]
+    path = SimpleNamespace(cc_mm=cc, surface=SimpleNamespace(size_z_mm=38.0), n_segments=4,
+                           tool_radius_mm=5.0)  # fmt: skip
+    err = np.array([0.0, 0.5, 12.0, 13.5])
+    data = {1: SimpleNamespace(path=path, exact=SimpleNamespace(error_um=err))}
+    cond = {c.id: c for c in zc.paper_conditions(data, load_paper_table("zhang2023_surfaces"),
+                                                 paper_fine_tuned=False)}  # fmt: skip
+    assert cond["s1_bbox_x"].met and cond["s1_bbox_y"].met and cond["s1_bbox_z"].met
+    assert not cond["s1_lines"].met and not cond["s1_samples"].met  # 2 and 4 against 200, 19,800
+    assert cond["s1_tool_radius"].met
+    assert cond["s1_err_max"].ours == 13.5 and cond["s1_err_max"].met  # 13 um, within 10 %
+    assert cond["s1_err_above_min"].ours == 75.0 and not cond["s1_err_above_min"].met
+    assert not cond["paper_recipe_fine_tuned"].met
+
+
+def test_time_ratio_rounds_up_to_a_power_of_ten() -> None:
+    from nctwin.chapters import zhang2023_claims as zc
+
+    timing = pd.DataFrame({"method": ["nn_prediction_with_model_import", "geometric_iterative"],
+                           "seconds": [0.03, 20.0]})  # fmt: skip
+    assert zc.time_ratio(timing) == pytest.approx(1e-2)  # 0.0015 -> 0.01
