@@ -2,10 +2,10 @@ r"""The experiment of Zhang et al. (2023): a BP network learns the exact step er
 CL segments on one free-form surface and is fine-tuned to two more.
 
 Per surface (Sec. "Sample construction"): the stand-in of :mod:`nctwin.physics.surfaces`, its
-iso-parametric path (200 lines x 100 CC points, R = 5 mm, 19,800 segments), the exact step
-error of every segment (:func:`nctwin.physics.steperror.step_error_um`, the network's target)
-and the Table 1 samples (:func:`nctwin.physics.steperror.step_error_samples`, with the number of
-inner points that makes the input width fit eq. 8 with a first hidden layer of 28).
+iso-parametric path (the paper's lines, CC points and tool radius), the exact step error of every
+segment (:func:`nctwin.physics.steperror.step_error_um`, the network's target) and the Table 1
+samples (:func:`nctwin.physics.steperror.step_error_samples`, with the number of inner points
+that makes the input width fit eq. 8 with the paper's first hidden layer).
 
 Training runs through the shared loop :func:`nctwin.learn.train.fit`, which learns on "programs" of
 consecutive rows. Samples are independent, so the training rows are cut, in a seeded random
