@@ -11,6 +11,7 @@ import pytest
 import torch
 
 from nctwin.chapters import denkena2020 as dk
+from nctwin.chapters import denkena2020_claims as dc
 from nctwin.chapters.denkena2020_bench import _segment
 from nctwin.physics import drives
 from nctwin.report.tables import Claim, load_paper_table
@@ -90,20 +91,65 @@ def test_rmse_per_window_by_hand() -> None:
 
 
 def test_two_sided_band_claims() -> None:
-    table = pd.DataFrame({"process": ["circular pocket", "side milling"],
-                          "lstm_cutting_rmse_n": [10.0, 20.0],
-                          "model_cutting_rmse_n": [30.0, 10.0],
-                          "lstm_cutting_nrmse": [0.1, 0.3],
-                          "semi_stable": [False, True]})  # fmt: skip
+    table = pd.DataFrame({"process": ["circular pocket", "side milling", "ramp milling"],
+                          "lstm_cutting_rmse_n": [10.0, 20.0, 12.0],
+                          "model_cutting_rmse_n": [30.0, 10.0, 40.0],
+                          "lstm_cutting_nrmse": [0.1, 0.3, 0.2],
+                          "semi_stable": [False, True, False]})  # fmt: skip
     summary = pd.DataFrame({"lstm_lower_pct": [40.0]})
     reversal = pd.DataFrame({"window": ["reversal windows", "rest of the cut"],
                              "lstm_rmse_n": [5.0, 5.0], "model_rmse_n": [20.0, 10.0]})  # fmt: skip
-    claims = {c.id: c for c in dk.claims(table, summary, reversal, (10.0, 35.0))}
+    paper = load_paper_table("denkena2020_summary")
+    claims = {c.id: c for c in dc.claims(table, summary, reversal, paper, (10.0, 35.0))}
     assert claims["lstm_lower_at_least"].holds and not claims["lstm_lower_at_most"].holds
     assert claims["reversal_model_fails"].value == 2.0
     assert claims["reversal_model_worse"].value == 15.0
     assert claims["pocket_model_worse"].value == 20.0
-    assert claims["worst_lstm_semi_stable"].holds
+    # LSTM below the model on 2 of 3 rows; ramp 12 against the mean 14
+    assert claims["lstm_better_most"].value == pytest.approx(200.0 / 3)
+    assert claims["ramp_below_average"].value == pytest.approx(12.0 / 14.0)
+    assert (
+        claims["worst_lstm_semi_stable"].holds and claims["worst_lstm_semi_stable"].whose == "ours"
+    )
+    assert "ramp_model_rmse_x" in claims["lstm_lower_at_least"].requires
+    assert claims["reversal_model_fails"].requires == dc.MODEL_REQUIRES
+
+
+def test_standing_axis_motion_counts_nonzero_velocity_while_cutting() -> None:
+    inputs = np.zeros((1, 4, 14))
+    inputs[0, :, 3] = [0.0, 0.05, -0.1, 0.3]  # X stands (set point), its velocity reads
+    inputs[0, :, 4] = 5.0  # Y moves
+    rec = SimpleNamespace(processes=[SimpleNamespace(kind="side", feed_direction="+y")],
+                          inputs=inputs)  # fmt: skip
+    moving = np.zeros((1, 4, 3), dtype=bool)
+    moving[0, :, 1] = True
+    cutting = np.array([[False, True, True, True]])
+    w = dk.Windows(cutting, moving, np.zeros_like(moving))
+    table = dc.standing_axis_motion(rec, w, [0], 0.05)
+    row = table.iloc[0]
+    assert (row.axis, row.samples, row.moving_share_pct) == ("X", 3, 100.0)
+    assert row.max_abs_v_mm_s == pytest.approx(0.3)
+    assert len(table) == 2 and table.iloc[-1].process == "all"
+
+
+def test_conditions_read_the_paper_and_measure_ours() -> None:
+    procs = [dk.Process(0, "ramp", "-y/+z", 10.0, 2.0, 600.0, 5000.0, (0, 0, 0), False, 0, 0,
+                        test=True),
+             dk.Process(1, "groove", "+x", 10.0, 1.0, 300.0, 2600.0, (0, 0, 0), False, 0, 0,
+                        test=True)]  # fmt: skip
+    targets = np.zeros((2, 4, 3))
+    recon = {0: np.full((4, 3), 50.6), 1: np.full((4, 3), 20.0)}
+    w = dk.Windows(np.ones((2, 4), dtype=bool), np.ones((2, 4, 3), dtype=bool),
+                   np.zeros((2, 4, 3), dtype=bool))  # fmt: skip
+    cond = {c.id: c for c in dc.paper_conditions(procs, targets, recon, w, GRID, 250.0, 6.0)}
+    assert cond["ramp_model_rmse_x"].ours == pytest.approx(50.6) and cond["ramp_model_rmse_x"].met
+    assert cond["ramp_model_rmse_y"].ours == pytest.approx(50.6)
+    assert not cond["ramp_model_rmse_y"].met  # paper 18.2 N
+    assert cond["groove_model_rmse"].ours == 20.0 and cond["groove_model_rmse"].met
+    # the ramp (f 600, n 5000) is off the grid, the groove on it; the paper's row is off it
+    assert (cond["test_off_grid"].paper, cond["test_off_grid"].ours) == (100.0, 50.0)
+    assert cond["sample_rate"].met and not cond["run_duration"].met
+    assert not cond["variations"].met and cond["test_processes"].ours == 2
 
 
 def test_claims_by_seed_reads_every_seed_beside_the_ensemble() -> None:
@@ -147,3 +193,31 @@ def test_seeds_train_in_parallel_with_the_sequential_bits(tmp_path, monkeypatch)
                 assert torch.equal(v, b.model.state_dict()[k]), (s, axis, k)
     # the seeds differ, the axes differ
     assert not torch.equal(one[0]["X"].model.head.weight, one[1]["X"].model.head.weight)
+
+
+def test_judged_claims_count_single_seeds_and_keep_the_model_claim_without_seeds() -> None:
+    procs = [dk.Process(0, "pocket", "ccw", 10.0, 1.0, 300.0, 2600.0, (0, 0, 0), False, 0, 0,
+                        test=True),
+             dk.Process(1, "ramp", "-y/+z", 10.0, 2.0, 300.0, 2600.0, (0, 0, 0), False, 0, 0,
+                        test=True),
+             dk.Process(2, "side", "+x", 2.0, 1.0, 300.0, 2600.0, (0, 0, 0), True, 50, 0.5,
+                        test=True)]  # fmt: skip
+    rec = SimpleNamespace(processes=procs)
+    targets = np.full((3, 4, 3), 100.0)
+    reversal = np.zeros((3, 4, 3), dtype=bool)
+    reversal[0, :2, 0] = True
+    w = dk.Windows(np.ones((3, 4), dtype=bool), np.ones((3, 4, 3), dtype=bool), reversal)
+    recon = {i: np.full((4, 3), 110.0) for i in range(3)}
+    # seed 0 errs by 2 N everywhere, seed 1 by 6 N: the ensemble by 4 N, the model by 10 N
+    per_seed = {0: {i: np.full((4, 3), 102.0) for i in range(3)},
+                1: {i: np.full((4, 3), 106.0) for i in range(3)}}  # fmt: skip
+    paper = load_paper_table("denkena2020_summary")
+    judged, by_seed = dc.judged_claims(rec, targets, per_seed, recon, w, paper)
+    c = {x.id: x for x in judged}
+    assert c["lstm_lower_at_least"].value == pytest.approx(60.0)  # 1 - 4/10
+    assert (c["lstm_lower_at_most"].seeds_passing, c["lstm_lower_at_most"].seeds) == (0, 2)
+    low, high = c["lstm_lower_at_least"].interval
+    assert 40.0 - 1e-9 <= low <= high <= 80.0 + 1e-9  # between seed 1's and seed 0's alone
+    assert c["reversal_model_fails"].seeds is None
+    row = by_seed.set_index("id").loc["lstm_lower_at_least"]
+    assert (row.seed_0, row.seed_1) == pytest.approx((80.0, 40.0))

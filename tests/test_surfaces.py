@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from nctwin.physics.surfaces import (
-    PAPER_SURFACES,
+    PAPER_BUMPS,
     BumpSurface,
     Cylinder,
     Sphere,
@@ -105,4 +105,4 @@ def test_bad_parameters_raise_value_error_naming_them() -> None:
         iso_parametric_path(Sphere(10.0), tool_radius_mm=-5.0)
     with pytest.raises(ValueError, match="index"):
         paper_surface(4)
-    assert sorted(PAPER_SURFACES) == [1, 2, 3]
+    assert sorted(PAPER_BUMPS) == [1, 2, 3]

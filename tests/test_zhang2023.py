@@ -190,3 +190,80 @@ def test_seed_runs_score_each_seed_and_their_mean() -> None:
     ens = table.iloc[-1]
     assert ens.test_mse == pytest.approx(np.mean(((mean - y[:, 0]) / 2.0) ** 2))
     assert ens.max_abs_err_um == pytest.approx(np.abs(mean - y[:, 0]).max())
+
+
+def test_conditions_compare_each_surface_with_the_papers_row() -> None:
+    from nctwin.chapters import zhang2023_claims as zc
+
+    cc = np.zeros((2, 3, 3))
+    cc[..., 0] = [0.0, 60.0, 120.0]
+    cc[..., 1] = np.array([0.0, 140.0])[:, None]
+    path = SimpleNamespace(cc_mm=cc, surface=SimpleNamespace(size_z_mm=38.0), n_segments=4,
+                           tool_radius_mm=5.0)  # fmt: skip
+    err = np.array([0.0, 0.5, 12.0, 13.5])
+    data = {1: SimpleNamespace(path=path, exact=SimpleNamespace(error_um=err))}
+    cond = {c.id: c for c in zc.paper_conditions(data, load_paper_table("zhang2023_surfaces"),
+                                                 paper_fine_tuned=False)}  # fmt: skip
+    assert cond["s1_bbox_x"].met and cond["s1_bbox_y"].met and cond["s1_bbox_z"].met
+    assert not cond["s1_lines"].met and not cond["s1_samples"].met  # 2 and 4 against 200, 19,800
+    assert cond["s1_tool_radius"].met
+    assert cond["s1_err_max"].ours == 13.5 and cond["s1_err_max"].met  # 13 um, within 10 %
+    assert cond["s1_err_above_min"].ours == 75.0 and not cond["s1_err_above_min"].met
+    assert not cond["paper_recipe_fine_tuned"].met
+
+
+def test_time_ratio_rounds_up_to_a_power_of_ten() -> None:
+    from nctwin.chapters import zhang2023_claims as zc
+
+    timing = pd.DataFrame({"method": ["nn_prediction_with_model_import", "geometric_iterative"],
+                           "seconds": [0.03, 20.0]})  # fmt: skip
+    assert zc.time_ratio(timing) == pytest.approx(1e-2)  # 0.0015 -> 0.01
+
+
+def test_judged_claims_judge_the_papers_recipe_seed_by_seed() -> None:
+    from nctwin.chapters import zhang2023_claims as zc
+
+    y = np.array([1.0, 2.0, 3.0, 4.0])
+    rows = np.arange(4)
+    data = {s: SimpleNamespace(x=np.zeros((4, 1)), y_um=y, exact=SimpleNamespace(error_um=y))
+            for s in (1, 2, 3)}  # fmt: skip
+    chain = [[SimpleNamespace(predicted_um=y + 0.2, test_rows=rows)]]
+    # a "network" is its own prediction of the test rows
+    networks = SimpleNamespace(seeds=(0, 1), paper=[y + 0.1, y + 0.7], variant=[y, y + 0.2],
+                               dropout=[y + 1.0, y + 1.0], transfer2=chain * 2,
+                               transfer3=chain * 2)  # fmt: skip
+    per_seed = pd.DataFrame({"network": ["paper settings (p = 0.5)"] * 3, "epochs": [10, 20, None]})
+    batches = pd.DataFrame({"batch_rows": [0, 0], "dropout_p": [0.5, 0.0], "test_mse": [0.9, 2.0],
+                            "epochs": [30, 2000], "converged": [True, False]})  # fmt: skip
+    transfer_tab = pd.DataFrame({"surface": [2, 2, 3, 3], "finetune_pct": [0.0, 15.0] * 2,
+                                 "share_below_1um_pct": [50.0, 100.0, 60.0, 100.0]})  # fmt: skip
+    timing = pd.DataFrame({"method": ["nn_prediction", "nn_prediction_with_model_import",
+                                      "nn_table1_samples", "geometric_iterative",
+                                      "exact_vectorised"],
+                           "seconds": [0.02, 0.03, 0.4, 20.0, 0.01]})  # fmt: skip
+    judged, by_seed = zc.judged_claims(
+        networks,
+        data,
+        rows,
+        rows,
+        lambda net, x: net,
+        per_seed,
+        batches,
+        transfer_tab,
+        (0.0, 15.0),
+        timing,
+        load_paper_table("zhang2023_summary"),
+        load_paper_table("zhang2023_table8"),
+        [],
+    )
+    c = {x.id: x for x in judged}
+    share = c["surface1_share_below_0p5um"]  # the ensemble errs by 0.4 um, the seeds 0.1, 0.7
+    assert share.value == 100.0 and (share.seeds_passing, share.seeds) == (1, 2)
+    assert share.whose == "paper" and "epochs 10-20" in share.text
+    assert c["surface1_max_err_um"].value == pytest.approx(0.4)
+    assert c["surface1_share_below_0p5um_variant"].whose == "ours"
+    assert c["dropout_helps"].value == pytest.approx(-1.1) and c["dropout_helps"].seeds is None
+    assert np.isnan(c["surface2_15pct_share_below_1um"].value)
+    assert "paper_recipe_fine_tuned" in c["surface2_15pct_share_below_1um"].requires
+    assert c["table8_time_ratio"].value == pytest.approx(0.01) and c["table8_time_ratio"].holds
+    assert set(by_seed["id"]) == {x.id for x in judged if x.seeds is not None}

@@ -12,7 +12,8 @@ The chapter's pipeline, kept out of the notebook:
    moves in its four steps.
 4. :func:`train_lstms` trains one stacked LSTM per force component and seed with the shared loop,
    in parallel; :func:`table2` and :func:`summary` score both methods, the LSTM by the mean of
-   the seeds' predictions, and :func:`seed_table` and :func:`claims_by_seed` give the spread.
+   the seeds' predictions, and :func:`seed_table` and :func:`claims_by_seed` give the spread;
+   the conditions and claims are in :mod:`nctwin.chapters.denkena2020_claims`.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from ..learn.train import TrainConfig, Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
 from ..report.claims import claims_by_seed
-from ..report.tables import Claim, side_by_side
+from ..report.tables import side_by_side
 from .denkena2020_bench import (
     DIRECTIONS,
     TOOL,
@@ -43,13 +44,11 @@ from .denkena2020_figures import band_coverage, figure_cases, plot_cases
 
 __all__ = [
     "DIRECTIONS",
-    "REDUCTION_BAND_PCT",
     "AirMoves",
     "Process",
     "Recorded",
     "Windows",
     "band_coverage",
-    "claims",
     "claims_by_seed",
     "design_processes",
     "figure_cases",
@@ -67,11 +66,6 @@ __all__ = [
     "train_config",
     "train_lstms",
 ]
-
-
-#: The band the LSTM's reduction of the cutting-window RMSE is judged in (%), stated before
-#: looking: around the paper's 20.8 %, wide enough for a different machine and test set.
-REDUCTION_BAND_PCT = (10.0, 35.0)
 
 
 def design_processes(
@@ -525,58 +519,3 @@ def kind_means(table: pd.DataFrame, paper2: pd.DataFrame) -> pd.DataFrame:
     ours_kind = pd.concat([ours_kind, semi], ignore_index=True)
     paper_rows = paper2.assign(process=paper2["process"].replace({"side milling": "semi-stable"}))
     return side_by_side(ours_kind, paper_rows, on=["process", "axis"], columns=cols)
-
-
-def claims(
-    table: pd.DataFrame,
-    summary: pd.DataFrame,
-    reversal: pd.DataFrame,
-    band_pct: tuple[float, float],
-) -> list[Claim]:
-    """The chapter's claims (Sec. 3.2, Figs. 6-8), all over the cutting window.
-
-    The LSTM's mean RMSE is lower than the model's by a share within ``band_pct`` (around the
-    paper's 20.8 %); on circular pockets the model's mean RMSE exceeds the LSTM's; in the
-    reversal windows the model's RMSE exceeds its RMSE on the rest of the cut, and the LSTM's
-    there; the worst LSTM case relative to its force (RMSE / max |F|) is a semi-stable process.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        :func:`table2`.
-    summary : pandas.DataFrame
-        :func:`summary` (column ``lstm_lower_pct``).
-    reversal : pandas.DataFrame
-        :func:`reversal_scores`.
-    band_pct : (float, float)
-        The band of the reduction, stated before looking.
-
-    Returns
-    -------
-    list of Claim
-    """
-    pockets = table[table["process"] == "circular pocket"]
-    worst = table.loc[table["lstm_cutting_nrmse"].idxmax()]
-    lower = summary["lstm_lower_pct"].iloc[0]
-    rev = reversal.set_index("window")
-    lo, hi = band_pct
-    return [
-        Claim("lstm_lower_at_least", f"Over the cut, the LSTM's mean RMSE is lower than the "
-              f"model's by at least {lo:g} % (paper: 20.8 %, Sec. 3.2)", lower, ">=", lo),
-        Claim("lstm_lower_at_most", f"... and by at most {hi:g} % (paper: 20.8 %, Sec. 3.2)",
-              lower, "<=", hi),
-        Claim("pocket_model_worse", "On circular pockets the model's mean RMSE over the cut "
-              "exceeds the LSTM's (N, model minus LSTM; paper: Figs. 6-7)",
-              pockets["model_cutting_rmse_n"].mean() - pockets["lstm_cutting_rmse_n"].mean(),
-              ">", 0.0),
-        Claim("reversal_model_fails", "The model fails where the feed direction reverses: its "
-              "RMSE in the reversal windows over its RMSE on the rest of the cut (Sec. 3.1-3.2)",
-              rev.loc["reversal windows", "model_rmse_n"]
-              / rev.loc["rest of the cut", "model_rmse_n"], ">", 1.0),
-        Claim("reversal_model_worse", "In the reversal windows the model's RMSE exceeds the "
-              "LSTM's (N, model minus LSTM)", rev.loc["reversal windows", "model_rmse_n"]
-              - rev.loc["reversal windows", "lstm_rmse_n"], ">", 0.0),
-        Claim("worst_lstm_semi_stable", "The worst LSTM case relative to its force (RMSE over "
-              "the cut / max |F|) is a semi-stable process (1 = yes; paper: Fig. 8)",
-              float(worst["semi_stable"]), "==", 1.0),
-    ]  # fmt: skip

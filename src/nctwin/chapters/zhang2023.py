@@ -2,10 +2,10 @@ r"""The experiment of Zhang et al. (2023): a BP network learns the exact step er
 CL segments on one free-form surface and is fine-tuned to two more.
 
 Per surface (Sec. "Sample construction"): the stand-in of :mod:`nctwin.physics.surfaces`, its
-iso-parametric path (200 lines x 100 CC points, R = 5 mm, 19,800 segments), the exact step
-error of every segment (:func:`nctwin.physics.steperror.step_error_um`, the network's target)
-and the Table 1 samples (:func:`nctwin.physics.steperror.step_error_samples`, with the number of
-inner points that makes the input width fit eq. 8 with a first hidden layer of 28).
+iso-parametric path (the paper's lines, CC points and tool radius), the exact step error of every
+segment (:func:`nctwin.physics.steperror.step_error_um`, the network's target) and the Table 1
+samples (:func:`nctwin.physics.steperror.step_error_samples`, with the number of inner points
+that makes the input width fit eq. 8 with the paper's first hidden layer).
 
 Training runs through the shared loop :func:`nctwin.learn.train.fit`, which learns on "programs" of
 consecutive rows. Samples are independent, so the training rows are cut, in a seeded random
@@ -18,8 +18,9 @@ difference of 4e-5 at 12,000 rows). The tool radius column is constant, so its Z
 Configurations
 --------------
 :func:`paper_configs`
-    The paper's settings: weights N(0, 1), dropout 0.5, SGD with momentum 0.8, lr 1e-5,
-    :data:`PAPER_EPOCHS` (2000) epochs as the cap with early stopping after
+    The paper's settings (read from ``data/papers/zhang2023_summary.csv``): weights N(0, 1),
+    its dropout, SGD with its momentum and learning rate, :data:`PAPER_EPOCHS` epochs as the
+    cap with early stopping after
     :data:`PAPER_PATIENCE` epochs without improvement, MSE. The paper gives no batch size (its
     SGD reads as one random sample per update); the default is the full batch, and
     :func:`batch_sweep` scores 1, 32, 256 rows and the full batch, with and without dropout.
@@ -32,7 +33,7 @@ Configurations
     at :data:`FINETUNE_EPOCHS`.
 
 Every network stops once its validation loss has not improved for :data:`PAPER_PATIENCE`
-epochs, or at its cap: the paper's :data:`PAPER_EPOCHS` (2000), :data:`FINETUNE_EPOCHS` for
+epochs, or at its cap: the paper's :data:`PAPER_EPOCHS`, :data:`FINETUNE_EPOCHS` for
 fine-tuning, :data:`BATCH_SWEEP_EPOCHS` for the batch sweep's runs at 32 and 256 rows;
 :attr:`nctwin.learn.train.Trained.converged` says which ended it.
 
@@ -42,7 +43,6 @@ Every network of the chapter is trained by :func:`nctwin.chapters.zhang2023_seed
 
 from __future__ import annotations
 
-import itertools
 import time
 from dataclasses import dataclass, replace
 from functools import partial
@@ -55,7 +55,7 @@ from ..checks import best_time_s
 from ..learn.models import BPConfig
 from ..learn.train import TrainConfig, Trained, fit, load_checkpoint
 from ..physics.steperror import step_error_iterative_um, step_error_samples, step_error_um
-from ..report.tables import Claim
+from ..report.tables import load_paper_table
 from .zhang2023_surfaces import HIDDEN, SurfaceData, chord_check, surface_data, surfaces_table
 from .zhang2023_tables import dropout_conventions, error_histogram, transfer_metrics
 
@@ -71,7 +71,6 @@ __all__ = [
     "batch_sweep",
     "best_time_s",
     "chord_check",
-    "claims",
     "dropout_conventions",
     "dropout_sweep",
     "error_histogram",
@@ -95,8 +94,11 @@ __all__ = [
 #: without a lower validation loss before training stops.
 PAPER_PATIENCE = 100
 
+#: The paper's settings (``data/papers/zhang2023_summary.csv``).
+_PAPER = load_paper_table("zhang2023_summary").set_index("quantity")["value"].astype(float)
+
 #: The paper's epochs (Sec. "Training"): the cap of training on surface 1.
-PAPER_EPOCHS = 2000
+PAPER_EPOCHS = int(_PAPER["epochs"])
 
 #: The cap of fine-tuning (the paper gives none), far above where early stopping ends it.
 FINETUNE_EPOCHS = 10_000
@@ -127,7 +129,7 @@ def paper_configs(
     n_inputs: int,
     *,
     seed: int = 0,
-    dropout: float = 0.5,
+    dropout: float = float(_PAPER["dropout_p"]),
     batch_rows: int | None = None,
     epochs: int = PAPER_EPOCHS,
 ) -> tuple[BPConfig, TrainConfig]:
@@ -138,12 +140,12 @@ def paper_configs(
     n_inputs : int
     seed : int
     dropout : float
-        Probability of dropping a hidden unit (paper: 0.5).
+        Probability of dropping a hidden unit (default: the paper's).
     batch_rows : int, optional
         Rows per update; None: all training rows (one update per epoch).
     epochs : int
-        Paper: 2000, the cap; training stops earlier once the validation loss has not improved
-        for :data:`PAPER_PATIENCE` epochs (the kept weights, those of the best validation
+        Default: the paper's, the cap; training stops earlier once the validation loss has not
+        improved for :data:`PAPER_PATIENCE` epochs (the kept weights, those of the best validation
         epoch, are then the same as after all ``epochs``).
 
     Raises
@@ -159,8 +161,8 @@ def paper_configs(
     window, batch = (99, 1_000_000) if batch_rows is None else (batch_rows, 1)
     train_config = TrainConfig(
         seed=seed, max_epochs=epochs, patience=min(epochs, PAPER_PATIENCE), batch_size=batch,
-        window_lines=window, learning_rate=1e-5, val_share=0.1, loss="mse", optimiser="sgd",
-        momentum=0.8,
+        window_lines=window, learning_rate=float(_PAPER["learning_rate"]), val_share=0.1,
+        loss="mse", optimiser="sgd", momentum=float(_PAPER["momentum"]),
     )  # fmt: skip
     return model, train_config
 
@@ -507,100 +509,3 @@ def timing_table(
     )
     timing.insert(2, "samples", d2.path.n_segments)
     return timing
-
-
-def claims(
-    runs: pd.DataFrame,
-    m1: dict[str, float],
-    transfer_tab: pd.DataFrame,
-    shares: tuple[float, ...],
-    timing: pd.DataFrame,
-    paper_summary: pd.DataFrame,
-) -> list[Claim]:
-    """The chapter's claims: the paper's accuracy on surface 1 at Table 3's own bars (with the
-    converging variant and with the paper's own settings), dropout, fine-tuning at the
-    abstract's bar on surfaces 2 and 3, and the ranking of Table 8.
-
-    The bars are read from ``paper_summary``: the share below 0.5 um must exceed the paper's
-    99.71 % rounded down to 0.1 (99.7), the largest error must not exceed the paper's, and the
-    shares below 1 um after 15 % fine-tuning must exceed the abstract's 99 %. The timing
-    claims are rankings measured in one run (value 1 = the ranking holds); the margins are
-    the ratios of the timing table, which is a measurement and is not kept with the results.
-
-    Parameters
-    ----------
-    runs : pandas.DataFrame
-        The surface-1 networks, one row each (``network``, ``test_mse``,
-        ``share_below_0p5um_pct``), among them ``"paper settings (p = 0.5)"``,
-        ``"variant (p = 0.5)"`` and ``"variant (p = 0)"``.
-    m1 : dict
-        :func:`transfer_metrics` of the variant without dropout on surface 1's test rows.
-    transfer_tab : pandas.DataFrame
-        :func:`transfer_table` of surfaces 2 and 3.
-    shares : tuple of float
-        The fine-tuning shares (%), in increasing order.
-    timing : pandas.DataFrame
-        :func:`timing_table`.
-    paper_summary : pandas.DataFrame
-        The paper table ``zhang2023_summary``.
-
-    Returns
-    -------
-    list of Claim
-    """
-    q = paper_summary.set_index("quantity")["value"].astype(float)
-    bar_0p5 = np.floor(10.0 * q["surface1_abs_err_lt_0p5um"]) / 10.0
-    max_err = q["surface1_max_abs_err"]
-    bar_1um = q["abs_err_lt_1um_after_15pct"]
-    seconds = timing.set_index("method")["seconds"]
-    t_exact = seconds["exact_vectorised"]
-    faster = {
-        "nn_import": t_exact < seconds["nn_prediction_with_model_import"],
-        "nn_forward": t_exact < seconds["nn_prediction"],
-        "nn_inputs": t_exact
-        < seconds["nn_table1_samples"] + seconds["nn_prediction_with_model_import"],
-    }
-    share = transfer_tab.set_index(["surface", "finetune_pct"])["share_below_1um_pct"]
-    drops = [share[(s, a)] - share[(s, b)] for s in (2, 3) for a, b in itertools.pairwise(shares)]
-    by_net = runs.set_index("network")
-    return [
-        Claim("surface1_share_below_0p5um",
-              f"Surface 1, 70/30 split: > {bar_0p5:g} % of test samples have absolute error "
-              "< 0.5 um (Zhang et al. 2023, Table 3; converging variant without dropout)",
-              m1["share_below_0p5um_pct"], ">", bar_0p5),
-        Claim("surface1_max_err_um",
-              "Surface 1: largest absolute test error (um) within the paper's (Table 3)",
-              m1["max_abs_err_um"], "<=", max_err),
-        Claim("surface1_paper_settings_share_below_0p5um",
-              f"Surface 1 with the paper's settings (N(0,1), dropout 0.5, SGD lr 1e-5, 2000 "
-              f"full-batch epochs): > {bar_0p5:g} % of test samples below 0.5 um (Table 3)",
-              by_net.loc["paper settings (p = 0.5)", "share_below_0p5um_pct"], ">", bar_0p5),
-        Claim("dropout_helps",
-              "Dropout 0.5 gives a lower test MSE than no dropout (Zhang et al. 2023, Fig. 6; "
-              "value: test MSE with dropout minus without)",
-              by_net.loc["variant (p = 0.5)", "test_mse"]
-              - by_net.loc["variant (p = 0)", "test_mse"], "<", 0.0),
-        Claim("surface2_15pct_share_below_1um",
-              f"Surface 2 after fine-tuning with 15 % of its samples: > {bar_1um:g} % below 1 um "
-              "(Zhang et al. 2023, Abstract, Table 6)", share[(2, 15.0)], ">", bar_1um),
-        Claim("surface3_15pct_share_below_1um",
-              f"Surface 3 after fine-tuning with 15 % of its samples: > {bar_1um:g} % below 1 um "
-              "(Zhang et al. 2023, Abstract, Table 7)", share[(3, 15.0)], ">", bar_1um),
-        Claim("more_finetuning_never_worse",
-              "More fine-tuning samples never lower the share below 1 um by more than noise "
-              "(value: largest drop between consecutive shares, surfaces 2 and 3; noise: 1 "
-              "percentage point)",
-              max(drops), "<=", 1.0),
-        Claim("exact_faster_than_nn",
-              "(c) the exact vectorised step error is faster than (a) the network's prediction "
-              "with model import (Table 8's definition); 1 = yes, in one run",
-              float(faster["nn_import"]), "==", 1.0, whose="ours"),
-        Claim("exact_faster_than_nn_forward",
-              "(c) is faster than the network's forward pass alone, without model import and "
-              "without building its 325 inputs; 1 = yes, in one run",
-              float(faster["nn_forward"]), "==", 1.0, whose="ours"),
-        Claim("exact_faster_than_nn_with_inputs",
-              "(c) is faster than the network including building its Table 1 inputs from the "
-              "surface and the model import; 1 = yes, in one run",
-              float(faster["nn_inputs"]), "==", 1.0, whose="ours"),
-    ]  # fmt: skip

@@ -18,7 +18,7 @@ fine-tuning), except the batch sweep's runs at 32 and 256 rows, which have a bud
 The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and
 are the same for every training seed. The claims judge the **mean of the seeds' predictions**
 (:func:`ensemble_um`, :func:`ensemble_transfer`); :func:`seed_runs` and
-:func:`nctwin.report.claims.claims_by_seed` give every seed's own numbers.
+:func:`nctwin.chapters.zhang2023_claims.judged_claims` give every seed's own numbers.
 """
 
 from __future__ import annotations
@@ -30,7 +30,6 @@ import numpy as np
 import pandas as pd
 
 from ..learn.train import Trained, TrainingDivergedError
-from ..report.claims import claims_by_seed
 from ..runner import run_tasks
 from .zhang2023 import (
     BATCH_RUNS,
@@ -49,7 +48,6 @@ from .zhang2023 import (
 
 __all__ = [
     "Networks",
-    "claims_by_seed",
     "ensemble_transfer",
     "ensemble_um",
     "seed_runs",

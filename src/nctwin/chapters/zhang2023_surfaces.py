@@ -18,12 +18,16 @@ from ..physics.steperror import (
     step_error_um,
 )
 from ..physics.surfaces import Cylinder, Sphere, ToolPath, iso_parametric_path, paper_surface
-from ..report.tables import side_by_side
+from ..report.tables import load_paper_table, side_by_side
 
 __all__ = ["HIDDEN", "SurfaceData", "chord_check", "surface_data", "surfaces_table"]
 
-#: Hidden layer widths of the paper (Sec. "Network parameter determination").
-HIDDEN = (28, 20)
+#: Hidden layer widths of the paper (Sec. "Network parameter determination"), read from
+#: ``data/papers/zhang2023_summary.csv``.
+HIDDEN = tuple(
+    int(load_paper_table("zhang2023_summary").set_index("quantity").loc[q, "value"])
+    for q in ("hidden_layer1_neurons", "hidden_layer2_neurons")
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,8 +40,8 @@ class SurfaceData:
         Surface 1, 2 or 3.
     path : ToolPath
     exact : StepError
-        Exact step errors, shape (19,800,).
-    x : ndarray, shape (19,800, 3 k + 13)
+        Exact step errors, shape (n,): one per segment.
+    x : ndarray, shape (n, 3 k + 13)
         Table 1 samples.
     """
 
@@ -53,7 +57,7 @@ class SurfaceData:
 
 
 def surface_data(index: int, *, n_inner: int | None = None) -> SurfaceData:
-    """Path, exact step errors and samples of surface ``index`` (paper: R = 5 mm, 200 x 100).
+    """Path, exact step errors and samples of surface ``index`` (the paper's path).
 
     ``n_inner`` defaults to :func:`nctwin.physics.steperror.inner_points_for_hidden_width` of
     :data:`HIDDEN` [0] (104 inner points, 325 inputs).
@@ -69,7 +73,7 @@ def surfaces_table(data: dict[int, SurfaceData], paper_surfaces: pd.DataFrame) -
     Parameters
     ----------
     data : dict
-        ``surface -> SurfaceData`` (paths of 200 x 100 CC points, 19,800 step errors each).
+        ``surface -> SurfaceData``.
     paper_surfaces : pandas.DataFrame
         The paper table ``zhang2023_surfaces``.
 

@@ -1,9 +1,10 @@
 r"""Smooth free-form surfaces and iso-parametric ball-end tool paths on them.
 
 Zhang et al. (2023) compute the step error of three-axis ball-end finishing paths on three
-free-form surfaces whose bounding boxes they give (120 x 140 x 38, 135 x 175 x 68.28 and
-150 x 150 x 54.02 mm) but whose shapes they do not. This module builds stand-ins with those boxes
-and the tool paths of the paper: 200 iso-parametric lines of 100 cutter-contact (CC) points each.
+free-form surfaces whose bounding boxes they give (``data/papers/zhang2023_surfaces.csv``) but
+whose shapes they do not. This module builds stand-ins with those boxes
+and the tool paths of the paper: iso-parametric lines of cutter-contact (CC) points, as many as
+the paper's (the same table).
 
 Conventions
 -----------
@@ -35,9 +36,10 @@ import numpy as np
 from scipy import optimize
 
 from ..checks import check_number
+from ..report.tables import load_paper_table
 
 __all__ = [
-    "PAPER_SURFACES",
+    "PAPER_BUMPS",
     "BumpSurface",
     "Cylinder",
     "GridSurface",
@@ -527,31 +529,26 @@ def iso_parametric_path(
     return ToolPath(surface, tool_radius_mm, u, v, cc, normal, cc + tool_radius_mm * normal)
 
 
-#: The three stand-in surfaces: bounding boxes of Zhang et al. (2023, Fig. 4); the bumps are ours,
-#: placed by hand and their widths then scaled once (bisection on the largest step error of the
-#: 200 x 100 path, R = 5 mm) so that each has convex and concave regions and step errors up to
-#: just under the paper's 13, 14 and 9 um.
-PAPER_SURFACES: dict[int, BumpSurface] = {
-    1: BumpSurface(
-        120.0, 140.0, 38.0,
-        ((0.30, 0.35, 0.2120, 0.2332, 1.0), (0.72, 0.65, 0.1908, 0.2120, 0.8),
-         (0.55, 0.20, 0.1696, 0.1484, -0.45), (0.25, 0.80, 0.1908, 0.1696, -0.35)),
-    ),
-    2: BumpSurface(
-        135.0, 175.0, 68.28,
-        ((0.40, 0.40, 0.2721, 0.2474, 1.0), (0.75, 0.75, 0.1979, 0.2227, 0.6),
-         (0.20, 0.80, 0.1856, 0.1979, -0.40), (0.80, 0.25, 0.1979, 0.1856, -0.45)),
-    ),
-    3: BumpSurface(
-        150.0, 150.0, 54.02,
-        ((0.50, 0.50, 0.3302, 0.3302, 1.0), (0.20, 0.25, 0.2202, 0.2202, -0.30),
-         (0.80, 0.75, 0.2339, 0.2339, -0.35), (0.78, 0.22, 0.2477, 0.2202, 0.35)),
-    ),
+#: The bumps of the three stand-in surfaces (each ``(x, y, sigma_x, sigma_y, weight)``, as
+#: :class:`BumpSurface` takes them), on the bounding boxes of Zhang et al. (2023, Fig. 4;
+#: ``data/papers/zhang2023_surfaces.csv``). The bumps are ours, placed by hand and their widths
+#: then scaled once (bisection on the largest step error of the paper's path) so that each
+#: surface has convex and concave regions and step errors up to just under the paper's largest.
+PAPER_BUMPS: dict[int, tuple[tuple[float, float, float, float, float], ...]] = {
+    1: ((0.30, 0.35, 0.2120, 0.2332, 1.0), (0.72, 0.65, 0.1908, 0.2120, 0.8),
+        (0.55, 0.20, 0.1696, 0.1484, -0.45), (0.25, 0.80, 0.1908, 0.1696, -0.35)),
+    2: ((0.40, 0.40, 0.2721, 0.2474, 1.0), (0.75, 0.75, 0.1979, 0.2227, 0.6),
+        (0.20, 0.80, 0.1856, 0.1979, -0.40), (0.80, 0.25, 0.1979, 0.1856, -0.45)),
+    3: ((0.50, 0.50, 0.3302, 0.3302, 1.0), (0.20, 0.25, 0.2202, 0.2202, -0.30),
+        (0.80, 0.75, 0.2339, 0.2339, -0.35), (0.78, 0.22, 0.2477, 0.2202, 0.35)),
 }  # fmt: skip
 
 
 def paper_surface(index: int) -> BumpSurface:
-    """Stand-in for surface ``index`` (1, 2 or 3) of Zhang et al. (2023)."""
-    if index not in PAPER_SURFACES:
+    """Stand-in for surface ``index`` (1, 2 or 3) of Zhang et al. (2023): the paper's bounding
+    box (read from ``data/papers/zhang2023_surfaces.csv``) with :data:`PAPER_BUMPS`."""
+    if index not in PAPER_BUMPS:
         raise ValueError(f"index = {index!r} is out of range: allowed 1, 2, 3")
-    return PAPER_SURFACES[index]
+    box = load_paper_table("zhang2023_surfaces").set_index("surface").loc[index]
+    return BumpSurface(float(box["bbox_x_mm"]), float(box["bbox_y_mm"]), float(box["bbox_z_mm"]),
+                       PAPER_BUMPS[index])  # fmt: skip
