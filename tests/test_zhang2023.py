@@ -145,13 +145,13 @@ def test_parallel_training_gives_the_sequential_bits(tmp_path, monkeypatch) -> N
 
     from nctwin.runner import run_tasks
 
-    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "sequential"))
+    monkeypatch.setenv("NCTWIN_CACHE", str(tmp_path / "sequential"))
     data, rows = _tiny_surface(0), np.arange(400)
     args = [(data, rows, *zh.variant_configs(7, max_epochs=3, seed=s), f"tiny{s}") for s in (0, 1)]
     one = [zs._train_or_none(*a) for a in args]
     # fresh workers that see a fresh cache: the networks are trained there, not loaded
     get_reusable_executor().shutdown(wait=True)
-    monkeypatch.setenv("NCTWIN_DATA", str(tmp_path / "parallel"))
+    monkeypatch.setenv("NCTWIN_CACHE", str(tmp_path / "parallel"))
     try:
         two = run_tasks(zs._call, [(zs._train_or_none, a) for a in args], n_jobs=2)
     finally:

@@ -56,14 +56,19 @@ from ..learn.models import BPConfig
 from ..learn.train import TrainConfig, Trained, fit, load_checkpoint
 from ..physics.steperror import step_error_iterative_um, step_error_samples, step_error_um
 from ..report.tables import load_paper_table
-from .zhang2023_surfaces import HIDDEN, SurfaceData, chord_check, surface_data, surfaces_table
+from .zhang2023_surfaces import (
+    SurfaceData,
+    chord_check,
+    paper_hidden,
+    surface_data,
+    surfaces_table,
+)
 from .zhang2023_tables import dropout_conventions, error_histogram, transfer_metrics
 
 __all__ = [
     "BATCH_RUNS",
     "BATCH_SWEEP_EPOCHS",
     "FINETUNE_EPOCHS",
-    "HIDDEN",
     "PAPER_EPOCHS",
     "PAPER_PATIENCE",
     "SurfaceData",
@@ -76,6 +81,7 @@ __all__ = [
     "error_histogram",
     "finetune_configs",
     "paper_configs",
+    "paper_hidden",
     "predict_um",
     "scaled_mse",
     "split",
@@ -157,7 +163,9 @@ def paper_configs(
         raise ValueError(f"batch_rows = {batch_rows!r} is out of range: allowed >= 1 or None")
     if epochs < 1:
         raise ValueError(f"epochs = {epochs!r} is out of range: allowed >= 1")
-    model = BPConfig(n_inputs=n_inputs, hidden=HIDDEN, dropout=dropout, weight_init="normal")
+    model = BPConfig(
+        n_inputs=n_inputs, hidden=paper_hidden(), dropout=dropout, weight_init="normal"
+    )
     window, batch = (99, 1_000_000) if batch_rows is None else (batch_rows, 1)
     train_config = TrainConfig(
         seed=seed, max_epochs=epochs, patience=min(epochs, PAPER_PATIENCE), batch_size=batch,
@@ -197,7 +205,9 @@ def variant_configs(
     for name, value in (("patience", patience), ("max_epochs", max_epochs)):
         if value < 1:
             raise ValueError(f"{name} = {value!r} is out of range: allowed >= 1")
-    model = BPConfig(n_inputs=n_inputs, hidden=HIDDEN, dropout=dropout, weight_init="uniform")
+    model = BPConfig(
+        n_inputs=n_inputs, hidden=paper_hidden(), dropout=dropout, weight_init="uniform"
+    )
     train_config = TrainConfig(
         seed=seed, max_epochs=max_epochs, patience=min(patience, max_epochs), batch_size=16,
         window_lines=8, learning_rate=1e-2, val_share=0.1, loss="mse", optimiser="sgd",

@@ -134,15 +134,15 @@ def judged_claims(
 ) -> tuple[list[Claim], pd.DataFrame]:
     """The chapter's claims, each saying which recipe it judges.
 
-    The paper's, on the paper's recipe: surface 1's share of test errors below 0.5 um above
-    Table 3's 99.71 % rounded down to 0.1, its largest error within Table 3's, each on the mean
-    of the seeds' networks with "k of n" single networks and a bootstrap interval; dropout
-    lowering the test MSE (Fig. 6; the batch sweep's full-batch runs, the chapter's seed);
-    surfaces 2 and 3 after 15 % fine-tuning above the abstract's 99 % below 1 um (not tested:
-    the paper's recipe is not fine-tuned here); Table 8, the network's time over the geometric
-    method's at most Table 8's ratio (rounded up to a power of ten, :func:`time_ratio`).
-    Ours: the same accuracy claims on the modified recipe, more fine-tuning never worse, and
-    the exact vectorised method faster than the network in three readings (rankings in one run).
+    The paper's, on the paper's recipe: surface 1's share of test errors below 0.5 um above Table
+    3's share (``surface1_abs_err_lt_0p5um``) rounded down to 0.1, its largest error within Table
+    3's, each on the mean of the seeds' networks with "k of n" single networks and a bootstrap
+    interval; dropout lowering the test MSE (Fig. 6; the batch sweep's full-batch runs, the
+    chapter's seed); surfaces 2 and 3 after 15 % fine-tuning above the abstract's 99 % below 1 um
+    (not tested: the paper's recipe is not fine-tuned here); Table 8, the network's time over the
+    geometric method's at most Table 8's ratio (rounded up to a power of ten, :func:`time_ratio`).
+    Ours: the same accuracy claims on the modified recipe, more fine-tuning never worse, and the
+    exact vectorised method faster than the network in three readings (rankings in one run).
 
     Parameters
     ----------

@@ -5,6 +5,7 @@ method against the chord formula. Nothing here trains a network.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,14 +21,17 @@ from ..physics.steperror import (
 from ..physics.surfaces import Cylinder, Sphere, ToolPath, iso_parametric_path, paper_surface
 from ..report.tables import load_paper_table, side_by_side
 
-__all__ = ["HIDDEN", "SurfaceData", "chord_check", "surface_data", "surfaces_table"]
+__all__ = ["SurfaceData", "chord_check", "paper_hidden", "surface_data", "surfaces_table"]
 
-#: Hidden layer widths of the paper (Sec. "Network parameter determination"), read from
-#: ``data/papers/zhang2023_summary.csv``.
-HIDDEN = tuple(
-    int(load_paper_table("zhang2023_summary").set_index("quantity").loc[q, "value"])
-    for q in ("hidden_layer1_neurons", "hidden_layer2_neurons")
-)
+
+@functools.cache
+def paper_hidden() -> tuple[int, int]:
+    """Hidden layer widths of the paper (Sec. "Network parameter determination"), read from
+    ``data/papers/zhang2023_summary.csv`` when first asked (a worker process of the runner may
+    see another data folder)."""
+    summary = load_paper_table("zhang2023_summary").set_index("quantity")
+    return tuple(int(summary.loc[q, "value"])
+                 for q in ("hidden_layer1_neurons", "hidden_layer2_neurons"))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,9 +64,9 @@ def surface_data(index: int, *, n_inner: int | None = None) -> SurfaceData:
     """Path, exact step errors and samples of surface ``index`` (the paper's path).
 
     ``n_inner`` defaults to :func:`nctwin.physics.steperror.inner_points_for_hidden_width` of
-    :data:`HIDDEN` [0] (104 inner points, 325 inputs).
+    :func:`paper_hidden` [0] (104 inner points, 325 inputs).
     """
-    k = inner_points_for_hidden_width(HIDDEN[0]) if n_inner is None else n_inner
+    k = inner_points_for_hidden_width(paper_hidden()[0]) if n_inner is None else n_inner
     path = iso_parametric_path(paper_surface(index))
     return SurfaceData(index, path, step_error_um(path), step_error_samples(path, k))
 
