@@ -75,12 +75,12 @@ def paper_conditions(
             Condition(f"test_piece_over_30min_set{s}", f"Sec. 4: the test piece runs over "
                       f"{over_min:g} min, set {s}", over_min, run_s / 60, "min", low=over_min),
         ]  # fmt: skip
-        for name, col, attr in (("atr", "atr_ms", "rapid_time_constant_s"),
-                                ("as", "as_ms", "rapid_bell_s"),
-                                ("at", "at_ms", "cut_time_constant_s")):  # fmt: skip
+        for name, label, col, attr in (("atr", "ATR", "atr_ms", "rapid_time_constant_s"),
+                                       ("as", "As", "as_ms", "rapid_bell_s"),
+                                       ("at", "AT", "at_ms", "cut_time_constant_s")):  # fmt: skip
             both = {getattr(model, attr), getattr(truth, attr)}
             ours = 1000 * both.pop() if len(both) == 1 else math.nan
-            out.append(Condition(f"{name}_set{s}", f"Sec. 3: {col[:-3].upper()}, set {s} "
+            out.append(Condition(f"{name}_set{s}", f"Sec. 3: {label}, set {s} "
                                  "(estimator and truth)", getattr(row, col), ours, "ms",
                                  tol_pct=0.0))  # fmt: skip
     row = val.loc[1]
