@@ -118,6 +118,7 @@ def test_claims_are_reported_not_asserted():
     assert "inpos_z_set1" in claims[f"accuracy_{tp}"].requires
     assert claims[f"accuracy_{f3}"].requires == ()
     assert claims["prediction_time"].holds and claims["prediction_time"].threshold == 1.0
+    assert claims["prediction_time"].value == pytest.approx(0.1)  # 2 ms rounded up to 0.1 s
     assert claims[f"overlap_matters_{tp}"].value == pytest.approx(99.95 - 95.0)
 
 
