@@ -106,12 +106,19 @@ def test_claims_are_reported_not_asserted():
                 rows.append({"program": prog, "param_set": s, "variant": variant,
                              "accuracy_pct": 100 - abs(e), "err_pct": e,
                              "cam_err_pct": cam})  # fmt: skip
-    claims = {c.id: c for c in lee.claims(pd.DataFrame(rows))}
-    assert len(claims) == 12
+    claims = {c.id: c for c in lee.claims(pd.DataFrame(rows), 0.002)}
+    assert len(claims) == 13
     tp, f3 = f"{lee.TEST_PIECE}_set1", f"{lee.FINISHING_3D}_set2"
     assert claims[f"accuracy_{tp}"].holds and not claims[f"accuracy_{f3}"].holds
+    assert claims[f"accuracy_{tp}"].threshold == 99.0  # the paper's "99 % or more"
     assert claims[f"beats_cam_{tp}"].value == pytest.approx(40.0)
-    assert not claims[f"beats_cam_{f3}"].holds
+    assert claims[f"beats_cam_{f3}"].value == pytest.approx(40.0 / 11.0)
+    assert claims[f"beats_cam_{f3}"].holds  # better than CAM: a ratio above 1
+    assert claims[f"beats_cam_{tp}"].whose == "paper" and claims[f"beats_cam_{f3}"].whose == "ours"
+    assert "inpos_z_set1" in claims[f"accuracy_{tp}"].requires
+    assert claims[f"accuracy_{f3}"].requires == ()
+    assert claims["prediction_time"].holds and claims["prediction_time"].threshold == 1.0
+    assert claims["prediction_time"].value == pytest.approx(0.1)  # 2 ms rounded up to 0.1 s
     assert claims[f"overlap_matters_{tp}"].value == pytest.approx(99.95 - 95.0)
 
 
@@ -130,3 +137,24 @@ def test_out_of_domain_rows_per_group():
     assert set(table.group) == {"train", "test"}
     assert table.programs.sum() + table.not_read.sum() == len(few)
     assert (table.max_abs_err_pct >= table.median_abs_err_pct).all()
+
+
+def test_conditions_are_the_papers_with_ours_beside():
+    from nctwin.chapters.lee2022_conditions import paper_conditions
+    from nctwin.machine import load_machine
+
+    machine = load_machine("fanuc_0i_testbed")
+    sets = lee.parameter_sets("fanuc_0i_testbed", load_paper_table("lee2022_validation"))
+
+    class Run:  # a truth run of 455 s
+        cycle_time_s = 455.0
+
+    inpos = {1: np.array([0.025, 0.030, 0.05]), 2: np.array([0.025, 0.025, 0.12])}
+    runs = {(lee.TEST_PIECE, s): Run() for s in sets}
+    conds = {c.id: c for c in paper_conditions(machine, sets, inpos, runs)}
+    assert conds["inpos_x_set1"].met and conds["inpos_y_set1"].met  # 30 ms: within 20 % of 25
+    assert not conds["inpos_z_set1"].met and conds["inpos_z_set2"].met  # 50 ms against 120
+    assert conds["test_piece_time_set1"].paper == 2169.1 and not conds["test_piece_time_set1"].met
+    assert conds["test_piece_over_30min_set1"].ours == pytest.approx(455 / 60)
+    assert all(conds[f"{c}_set{s}"].met for c in ("atr", "as", "at") for s in (1, 2))
+    assert conds["rapid_set1"].met and conds["rapid_linear_set1"].met

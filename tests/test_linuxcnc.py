@@ -277,3 +277,22 @@ def test_samples_follow_a_subroutine_whose_lines_repeat():
     )
     tp = dataclasses.replace(parse("G1 X1 F600\n" * 8), line=block_line)
     assert lc.motion_of(rec, tp).block.tolist() == [0, 0, 1, 3, 3, 3, 4, 4, 6, 7, 7]
+
+
+def test_experiment_conditions_by_hand():
+    from types import SimpleNamespace
+
+    from nctwin.chapters import linuxcnc as rk
+
+    profile = load_profile("linuxcnc_sim")
+    # 1 s at the 1 ms servo period: 1001 samples; a 10 ms trace holds 101
+    rec = SimpleNamespace(n_samples=1001, feed_mm_s=np.full(101, 150.0))
+    recordings = {f"train_{i}": rec for i in range(60)} | {"public_a": rec}
+    programs = {"startup": ("public", parse("G1 X1 F100\nG64\nG1 X2"), None),
+                "set": ("public", parse("G64 P0.1\nG1 X1 F100"), None)}  # fmt: skip
+    conds = {c.id: c for c in rk.experiment_conditions(recordings, programs, profile)}
+    assert conds["recordings_train"].met and conds["recordings_public"].ours == 1.0
+    assert not conds["recordings_public"].met and not conds["recordings_broad"].met
+    assert conds["trace_period"].ours == pytest.approx(10.0) and conds["trace_period"].met
+    assert conds["feed_within_ini"].ours == 150.0 and conds["feed_within_ini"].met
+    assert conds["startup_mode_programs"].ours == 1.0 and not conds["startup_mode_programs"].met

@@ -49,19 +49,22 @@ from ..identify import identified_block_overlap
 from ..kernel import linuxcnc
 from ..learn.train import Trained
 from ..machine import Machine, Profile
-from ..recordings import RecordedProgram, public_program_text
+from ..recordings import TRACE_PERIOD_S, RecordedProgram, public_program_text
+from ..report.conditions import Condition
 from ..report.tables import Claim, error_pct
 from ..targets import block_targets
 from ..toolpath import MotionKind, PathMode, Toolpath
 from .your_program import ProgramResult, block_feeds, program_times, run_program
 
 __all__ = [
+    "DESIGN_COUNTS",
     "EVERY_PROGRAM_SETS",
     "METHOD_COLUMNS",
     "PLANNER_RULES",
     "analytic_times",
     "claims",
     "evaluation_programs",
+    "experiment_conditions",
     "method_rows",
     "method_summary",
     "path_control",
@@ -366,6 +369,74 @@ def _value(row: pd.Series | None, column: str):
 
 #: The sets of every program LinuxCNC runs that is not one of nctwin's training or test sets.
 EVERY_PROGRAM_SETS = ("public", "language")
+#: The experiment's design: recordings per set (the recording's name up to its first ``_``).
+DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 5, "public": 14}
+#: The claims on the public programs, which need every program's path-control mode known
+#: (condition ``startup_mode_programs`` of :func:`experiment_conditions`).
+PUBLIC_CLAIMS = ("best_median_public", "best_worst_public", "best_beats_cam_public",
+                 "generic_median_public", "generic_worst_public", "planner_median_public",
+                 "planner_worst_public", "planner_median_every", "planner_worst_every")  # fmt: skip
+
+
+def experiment_conditions(
+    recordings: dict[str, RecordedProgram],
+    programs: dict[str, tuple[str, Toolpath, MoveData]],
+    profile: Profile,
+) -> list[Condition]:
+    """The conditions of the chapter's own experiment, its design beside the recordings.
+
+    * ``recordings_<set>``: the recordings of each set, as designed (:data:`DESIGN_COUNTS`);
+    * ``trace_period``: the shipped feed trace's period (its samples over the run's servo
+      periods) within 1 % of :data:`~nctwin.recordings.TRACE_PERIOD_S`, for every recording;
+    * ``feed_within_ini``: the recorded path speed never above the INI's maximum velocity (the
+      profile's ``max_feed_mm_s``) by more than 0.1 %;
+    * ``startup_mode_programs``: no scored program runs a motion under the startup code's path
+      mode (a block before any ``G61``/``G64`` word): LinuxCNC was found to run such blocks as a
+      plain ``G64`` although the INI's ``RS274NGC_STARTUP_CODE`` sets a tolerance, which the
+      methods are given (:meth:`~nctwin.toolpath.Toolpath.effective_tolerance_mm`).
+
+    Parameters
+    ----------
+    recordings : dict
+        :func:`nctwin.recordings.load_recordings`.
+    programs : dict
+        :func:`evaluation_programs`.
+    profile : Profile
+        ``linuxcnc_sim``.
+
+    Returns
+    -------
+    list of Condition
+    """
+    period_s = profile.control("planner").period_s
+    counts = {k: sum(n.split("_")[0] == k for n in recordings) for k in DESIGN_COUNTS}
+    trace = [(r.n_samples - 1) * period_s / (len(r.feed_mm_s) - 1) for r in recordings.values()]
+    worst = max(trace, key=lambda t: abs(t - TRACE_PERIOD_S))
+    feed = max(float(r.feed_mm_s.max()) for r in recordings.values())
+    moving = [(tp.path_mode[tp.kind != MotionKind.DWELL] == PathMode.DEFAULT).any()
+              for _, tp, _ in programs.values()]  # fmt: skip
+    out = [
+        Condition(
+            f"recordings_{k}",
+            f"recordings of the {k}_* set, as designed",
+            n,
+            counts[k],
+            "programs",
+            tol_pct=0.0,
+        )
+        for k, n in DESIGN_COUNTS.items()
+    ]
+    max_feed = profile.machine.max_feed_mm_s
+    return [
+        *out,
+        Condition("trace_period", "feed trace period of every recording (within 1 %)",
+                  1000 * TRACE_PERIOD_S, 1000 * worst, "ms", tol_pct=1.0),
+        Condition("feed_within_ini", "largest recorded path speed, at most the INI's maximum "
+                  "velocity (+0.1 %)", max_feed, feed, "mm/s", high=1.001 * max_feed),
+        Condition("startup_mode_programs", "scored programs with motion under the startup "
+                  "code's path mode (LinuxCNC runs it as a plain G64)", 0.0, float(sum(moving)),
+                  "programs", high=0.0),
+    ]  # fmt: skip
 
 
 def claims(
@@ -452,4 +523,5 @@ def claims(
               f"the same {n} programs", every.max() if n else float("nan"), "<=", 3.0),
     ]  # fmt: skip
     # none of the papers ran LinuxCNC: every claim of this chapter is nctwin's own
-    return [dataclasses.replace(c, whose="ours") for c in claims]
+    return [dataclasses.replace(c, whose="ours", requires=("startup_mode_programs",)
+                                if c.id in PUBLIC_CLAIMS else ()) for c in claims]  # fmt: skip

@@ -2,9 +2,12 @@ r"""A Fanuc-like control simulated in the time domain: the "measured" machine of
 
 The chapter on Lee et al. 2022 (J. Korean Soc. Precis. Eng. 39(7), 537-543; a Fanuc 0i-MD
 three-axis testbed) tests an analytic cycle-time estimate against a machine. This kernel is that
-machine. It shares no code and no equation with the estimate: nothing here computes a block's
-time; every time comes out of a loop that advances the control one interpolation period
-:math:`T_I` at a time, as the control does, and counts the periods.
+machine. It shares no code with the estimate, and no block's time is computed here: every time
+comes out of a loop that advances the control one interpolation period :math:`T_I` at a time, as
+the control does, and counts the periods. It shares two of the estimate's equations, though: each
+cutting block is rounded up to whole periods, :math:`\max(\lceil l/(F T_I) \rceil,
+\lceil t_b/T_I \rceil)` periods (the paper's eq. 2, :func:`simulate`), with no remainder carried
+into the next block; and the rapid acceleration is :math:`F_r / A_{TR}` (eq. 9).
 
 What one period does
 --------------------
@@ -330,7 +333,7 @@ def measure_inposition_times(
     For each axis, one single-axis rapid per distance is run from rest on :func:`simulate`
     (the paper: five repeats per axis); the time from the end of the rapid's command until
     every axis is within its in-position width is recorded, and the mean per axis is the
-    in-position time (the paper's testbed: X, Y 25 ms, Z 120 ms).
+    in-position time (the paper's testbed's are in ``data/papers/lee2022_inposition.csv``).
 
     Parameters
     ----------

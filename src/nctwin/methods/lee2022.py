@@ -35,7 +35,7 @@ Block overlap (Sec. 2.2, Fig. 6-8)
     (Fig. 7). Rapids and dwells are not overlapped: the next block starts when they end.
 In-position (Sec. 2.3)
     After each rapid, the measured in-position time of the slowest of the moving axes is added
-    (the paper: X, Y 25 ms, Z 120 ms; mean of 5 repeated single-axis rapids).
+    (the paper's, means of repeated single-axis rapids: ``data/papers/lee2022_inposition.csv``).
 
 Per-block times (:func:`overlapped_block_times`, which
 :func:`nctwin.estimate.block_overlap.block_overlap` reports as an estimate): a cutting block gets
