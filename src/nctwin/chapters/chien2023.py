@@ -64,7 +64,7 @@ from ..methods import chien2023 as chien
 from ..motion import Motion
 from ..physics.measure import Recording
 from ..programs import write_programs
-from ..report.tables import Claim, error_pct, side_by_side
+from ..report.tables import error_pct, side_by_side
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath
@@ -79,7 +79,6 @@ __all__ = [
     "ProgramRun",
     "Recording",
     "ablation_table",
-    "claims",
     "convergence",
     "cutting_blocks",
     "cycle_time_rows",
@@ -615,46 +614,3 @@ def ablation_table(
                     "seed_max_err_pct": seed_max,
                     "best_epoch_min": min(epochs), "best_epoch_max": max(epochs)})  # fmt: skip
     return pd.DataFrame(out).round(2)
-
-
-def claims(
-    rows: pd.DataFrame, rows_b: pd.DataFrame, table1: pd.DataFrame, table2: pd.DataFrame
-) -> list[Claim]:
-    """The paper's claims at its own level, judged on the ensembles.
-
-    The rule, fixed before any network was trained: a table's prediction is the ensemble mean
-    of its networks (one per seed, :func:`predict_run`), and a claim holds when it holds for the
-    ensemble on every row. The BiLSTM's error is at most 3 % on every row of Tables 1-2 (the
-    paper prints 0.8-2.2 %) and at most 7 % on every row of Table 3 (paper: 3-6 %); CAM
-    underestimates every row, by at least 20 % on Tables 1 and 2 (paper: 27-41 %).
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        :func:`cycle_time_rows` of the simulation's test programs (Tables 1-2), with a
-        ``bilstm`` model (the ensemble).
-    rows_b : pandas.DataFrame
-        The same for machine B (Table 3).
-    table1, table2 : pandas.DataFrame
-        :func:`paper_beside` of Tables 1 and 2 (column ``cam_err_pct``).
-
-    Returns
-    -------
-    list of Claim
-    """
-    return [
-        Claim("sim_bilstm_err_max",
-              "BiLSTM ensemble error <= 3 % on every row of Tables 1-2 (paper 0.8-2.2 %)",
-              rows.bilstm_err_pct.max(), "<=", 3.0),
-        Claim("b_bilstm_err_max",
-              "BiLSTM ensemble error <= 7 % on every row of Table 3 (paper 3-6 %)",
-              rows_b.bilstm_err_pct.max(), "<=", 7.0),
-        Claim("cam_underestimates", "CAM underestimates on every row of Tables 1-3 (count of rows "
-              "where it does not)", ((rows.cam_s >= rows.measured_s).sum()
-                                     + (rows_b.cam_s >= rows_b.measured_s).sum()), "==", 0,
-              whose="ours"),
-        Claim("table1_cam_err_min", "CAM error >= 20 % on every row of Table 1 (paper 27-34 %)",
-              table1.cam_err_pct.min(), ">=", 20.0, whose="ours"),
-        Claim("table2_cam_err_min", "CAM error >= 20 % on every row of Table 2 (paper 35-41 %)",
-              table2.cam_err_pct.min(), ">=", 20.0, whose="ours"),
-    ]  # fmt: skip
