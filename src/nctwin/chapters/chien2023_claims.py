@@ -28,6 +28,7 @@ __all__ = [
     "TABLE_CLAIMS",
     "claims",
     "paper_conditions",
+    "paper_numbers",
     "summary_value",
 ]
 
@@ -53,6 +54,41 @@ def summary_value(quantity: str, column: str = "value") -> float:
     """A number of ``data/papers/chien2023_summary.csv`` (``column`` of row ``quantity``)."""
     summary = load_paper_table("chien2023_summary").set_index("quantity")
     return float(summary.loc[quantity, column])
+
+
+def paper_numbers() -> dict[str, float]:
+    """The paper's numbers the chapter's text quotes, by name (for ``glue``).
+
+    Returns
+    -------
+    dict
+        ``paper_<quantity>`` (and ``paper_<quantity>_max`` where a range) of every row of
+        ``chien2023_summary.csv``; per table ``paper_<table>_<column>_min`` and ``_max`` of its
+        ``cam_err``, ``bilstm_err``, ``cam_s``, ``feed`` and ``ratio`` (measured/CAM) and
+        ``path_m`` (the path its CAM times imply, :math:`T_{CAM} F`), and
+        ``paper_<table>_path_m_mean``.
+    """
+    out = {}
+    for row in load_paper_table("chien2023_summary").itertuples():
+        out[f"paper_{row.quantity}"] = float(row.value)
+        if not np.isnan(row.value_max):
+            out[f"paper_{row.quantity}_max"] = float(row.value_max)
+    for table in TABLE_CLAIMS:
+        p = load_paper_table(f"chien2023_{table}")
+        path_m = p.cam_s * p.feed_mm_s / 1000
+        columns = {
+            "cam_err": p.cam_err_pct,
+            "bilstm_err": p.bilstm_err_pct,
+            "cam_s": p.cam_s,
+            "feed": p.feed_mm_s,
+            "ratio": p.measured_s / p.cam_s,
+            "path_m": path_m,
+        }
+        for name, values in columns.items():
+            out[f"paper_{table}_{name}_min"] = float(values.min())
+            out[f"paper_{table}_{name}_max"] = float(values.max())
+        out[f"paper_{table}_path_m_mean"] = float(path_m.mean())
+    return out
 
 
 def _row_id(table: str, toolpath: str, feed: float, tol: float) -> str:
