@@ -31,6 +31,7 @@ __all__ = [
     "claims",
     "outcome",
     "paper_conditions",
+    "paper_numbers",
     "seed_feeds",
     "summary_value",
 ]
@@ -49,6 +50,18 @@ def summary_value(quantity: str) -> float:
     """A number of ``data/papers/sun2022_summary.csv``."""
     summary = load_paper_table("sun2022_summary").set_index("quantity")
     return float(summary.loc[quantity, "value"])
+
+
+def paper_numbers() -> dict[str, float]:
+    """The paper's numbers the chapter's text quotes, by name (for ``glue``): ``paper_<quantity>``
+    of every row of ``sun2022_summary.csv``, ``paper_pocket1_measured_s`` (Table 3) and
+    ``paper_pocket1_rate`` (records per second on pocket 1)."""
+    out = {f"paper_{row.quantity}": float(row.value)
+           for row in load_paper_table("sun2022_summary").itertuples()}  # fmt: skip
+    measured = float(load_paper_table("sun2022_table3").set_index("pocket").loc[1, "measured_s"])
+    out["paper_pocket1_measured_s"] = measured
+    out["paper_pocket1_rate"] = out["paper_pocket1_measured_points"] / measured
+    return out
 
 
 def _pocket_ids(pockets: Sequence[int]) -> tuple[str, ...]:
