@@ -35,18 +35,18 @@ from ..methods import sun2022 as sun
 from ..motion import Motion
 from ..physics.measure import ControllerSamples, controller_samples, nearest_sample
 from ..programs.thinwall import POCKETS, pocket_program, start_mm
-from ..report.tables import Claim, error_pct
+from ..report.tables import error_pct
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath
 from .your_program import ProgramResult, block_feeds, domain_notes, program_times, run_program
 
 __all__ = [
+    "IMPROVED_POCKETS",
     "MODELS",
     "SEEDS",
     "TRAIN_CONFIG",
     "PocketRun",
-    "claims",
     "error_sources",
     "machine_check",
     "part_stats",
@@ -489,51 +489,3 @@ def error_sources(
 #: Pockets on which the paper's model #2 improved on model #1 (Sec. 4.2: "though the error for
 #: pocket #1 and #4 was slightly increased, the error for other pockets was improved").
 IMPROVED_POCKETS = (2, 3, 5, 6, 7, 8)
-
-
-def claims(sources: pd.DataFrame, table3: pd.DataFrame) -> list[Claim]:
-    """The paper's claims at its own level, judged on the ensemble mean of the seeds, on its own
-    set-up (5 Hz targets) and, as a separate row each, with 1 kHz block-average targets.
-
-    Model #1's error is under 10 % on every pocket (Sec. 4.1, Table 3); model #2's is at most
-    3 % on every pocket (Sec. 4.2, Table 4) and lower than model #1's on every pocket but 1 and
-    4 (Sec. 4.2); CAD/CAM underestimates every pocket (Table 3).
-
-    Parameters
-    ----------
-    sources : pandas.DataFrame
-        :func:`error_sources`.
-    table3 : pandas.DataFrame
-        Table 3 (columns ``cam_s``, ``measured_s``).
-
-    Returns
-    -------
-    list of Claim
-    """
-    err = sources.set_index("pocket")
-    improved = list(IMPROVED_POCKETS)
-    claims = []
-    for key, label in (("5hz", "5 Hz records"), ("1khz", "1 kHz block averages")):
-        m1, m2 = err[f"m1_{key}_err_pct"].abs(), err[f"m2_{key}_err_pct"].abs()
-        claims += [
-            Claim(f"model1_below_10pct_{key}", f"model #1 error < 10 % on every pocket ({label})",
-                  m1.max(), "<", 10.0),
-            Claim(f"model2_below_3pct_{key}", f"model #2 error <= 3 % on every pocket ({label})",
-                  m2.max(), "<=", 3.0),
-            Claim(f"model2_improves_2_3_5_6_7_8_{key}",
-                  f"model #2 error lower than model #1 on pockets 2, 3, 5, 6, 7, 8 ({label}); "
-                  f"value: largest (model #2 - model #1) in percentage points",
-                  (m2[improved] - m1[improved]).max(), "<", 0.0),
-        ]  # fmt: skip
-    cam_under = (table3["cam_s"] < table3["measured_s"]).all()
-    claims.append(
-        Claim(
-            "cam_underestimates",
-            "CAD/CAM underestimates every pocket (1 = all)",
-            float(cam_under),
-            "==",
-            1.0,
-            whose="ours",
-        )
-    )
-    return claims

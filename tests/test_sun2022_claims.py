@@ -1,0 +1,37 @@
+"""Sun et al. (2022): the conditions against Table 3 and Sec. 4.1."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from nctwin.chapters import sun2022_claims as sc
+
+
+def _run(cam_s: float, measured_s: float, cls: int = 100, records: int = 10):
+    """What the conditions read of a pocket's run."""
+    return SimpleNamespace(
+        cam_s=cam_s,
+        measured_s=measured_s,
+        toolpath=range(cls),
+        records=SimpleNamespace(t_s=np.zeros(records)),
+    )
+
+
+def test_conditions_read_table3_and_pocket1():
+    # pocket 1 as printed: CAD/CAM 273 s of 308 s measured is 11.36 % under; 5383 cutter
+    # locations; 901 records over 308 s, 2.925 a second
+    runs = {
+        1: _run(273.0, 308.0, cls=5383, records=901),
+        2: _run(63.0, 63.0),
+    }  # pocket 2: the paper's CAD/CAM time, no error (paper 19.23)
+    conds = {c.id: c for c in sc.paper_conditions(runs)}
+    assert conds["pocket1_cam_err"].ours == pytest.approx(11.364, abs=1e-3)
+    assert all(
+        conds[i].met for i in ("pocket1_cam_s", "pocket1_cam_err", "pocket1_cls", "logger_rate")
+    )
+    assert conds["logger_rate"].paper == pytest.approx(901 / 308)
+    assert conds["pocket2_cam_s"].met and not conds["pocket2_cam_err"].met
+    # five records a second, as our logger keeps, are 71 % over the paper's rate
+    fast = sc.paper_conditions({1: _run(273.0, 308.0, cls=5383, records=1540)})
+    assert not {c.id: c for c in fast}["logger_rate"].met
