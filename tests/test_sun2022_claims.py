@@ -35,3 +35,21 @@ def test_conditions_read_table3_and_pocket1():
     # five records a second, as our logger keeps, are 71 % over the paper's rate
     fast = sc.paper_conditions({1: _run(273.0, 308.0, cls=5383, records=1540)})
     assert not {c.id: c for c in fast}["logger_rate"].met
+
+
+def test_the_papers_own_numbers_pass_every_claim_it_makes():
+    from nctwin.report.tables import OPS, load_paper_table
+
+    t3 = load_paper_table("sun2022_table3").sort_values("pocket")
+    t4 = load_paper_table("sun2022_table4").sort_values("pocket")
+    outcome = {
+        "err_pct": np.vstack([t3.nn_err_pct.to_numpy(), t4.nn_err_pct.to_numpy()]),
+        "cam_err_pct": t3.cam_err_pct.to_numpy(),
+        "g0_err_s": np.array([2.0, -0.5]),
+    }  # model #1 off over the rapids, #2 less so
+    for cid, _, op, bar, value, _ in sc._specs():
+        assert OPS[op](value(outcome), bar), cid
+    # model #2 over its bar on one pocket, and no better than model #1 there
+    outcome["err_pct"][1, 2] = outcome["err_pct"][0, 2] + 0.5
+    failing = {cid for cid, _, op, bar, value, _ in sc._specs() if not OPS[op](value(outcome), bar)}
+    assert failing == {"model2_all_pockets", "model2_improves"}
