@@ -139,7 +139,7 @@ def test_the_repository_page_renders():
 
 def test_a_learned_claim_shows_its_interval_and_single_networks():
     record = {"value": 2.5, "interval": [1.25, 3.5], "seeds_passing": 3, "seeds": 5}
-    assert verdicts._ours(record) == "2.5 (1.25 to 3.5); 3 of 5 nets pass"
+    assert verdicts._ours(record) == "2.5<br>(1.25 to 3.5)<br>3 of 5 nets"
     assert verdicts._ours({"value": None}) == "-"
 
 

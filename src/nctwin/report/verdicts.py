@@ -176,13 +176,14 @@ STATUSES = (
 
 
 def _ours(record: dict) -> str:
-    """The value, and for a learned claim the interval and how many single networks pass."""
+    """The value, and for a learned claim the interval and how many single networks pass, each
+    on a line of its own (the column does not wrap)."""
     text = _number(record["value"])
     if "interval" in record:
         low, high = record["interval"]
-        text += f" ({_number(low)} to {_number(high)})"
+        text += f"<br>({_number(low)} to {_number(high)})"
     if "seeds" in record:
-        text += f"; {record['seeds_passing']} of {record['seeds']} nets pass"
+        text += f"<br>{record['seeds_passing']} of {record['seeds']} nets"
     return text
 
 
