@@ -88,3 +88,10 @@ def test_claims_cell_is_one_call(path):
     (stmt,) = tree.body
     assert isinstance(stmt, ast.Expr), f"cell {i} is not a bare call"
     assert called_name(stmt.value) == "report_claims", f"cell {i} does not call report_claims"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_notebook_is_valid_nbformat(path):
+    """nbconvert refuses an invalid notebook (a tag given twice is one), so the book would too."""
+    nbformat = pytest.importorskip("nbformat")
+    nbformat.validate(nbformat.read(path, as_version=4))
