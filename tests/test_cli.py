@@ -599,4 +599,3 @@ def test_overrides_out_of_range_give_one_line(program, capsys, option, value):
     assert _one_line_error(capsys).startswith(
         f"nctwin: argument {option}: {value} is out of range: allowed (0, 200] %"
     )
-

@@ -79,6 +79,17 @@ def repo_root() -> Path:
     return source_root() or Path.cwd()
 
 
+def shown(path: Path) -> Path:
+    """``path`` as a reader should see it: relative to :func:`repo_root` where it lies under it.
+
+    A cache or data folder set elsewhere (``NCTWIN_CACHE``, ``NCTWIN_DATA``) is shown whole.
+    """
+    try:
+        return path.resolve().relative_to(repo_root())
+    except ValueError:
+        return path
+
+
 def _package_data() -> Path:
     """The package's own ``data`` folder (resolved), or ``<root>/data`` in a checkout whose
     link ``src/nctwin/data`` is missing (a checkout without symbolic links)."""
