@@ -160,11 +160,14 @@ def test_long_rapid_takes_l_over_fr_plus_atr_plus_as():
     assert r.cycle_time_s == pytest.approx(r.command_end_s[0] + r.inposition_wait_s[0])
 
 
-def test_short_rapid_is_a_triangle_at_the_rapid_acceleration():
-    # 5 mm never reaches Fr: accelerate and brake at Fr / ATR (Lee et al. 2022, Fig. 4)
+def test_short_rapid_is_its_interpolation_smoothed_over_the_time_constant():
+    # acc/dec after interpolation: 5 mm are interpolated at Fr in 30 periods, and the moving
+    # average over ATR spreads them over 30 + 150 - 1 periods, never reaching Fr: a flat top at
+    # l / ATR (the paper's eq. 9-12 price it as a triangle at Fr / ATR, 134 ms: shorter)
     r = sim("G0 X5", rapid_bell_s=0.0)
-    assert r.command_end_s[0] == pytest.approx(2 * math.sqrt(5.0 / A_RAPID), abs=2 * TI)
-    assert command_speed(r).max() == pytest.approx(math.sqrt(A_RAPID * 5.0), rel=0.02)
+    assert r.command_end_s[0] == pytest.approx(5.0 / FR + 0.15 - TI, abs=1e-12)
+    assert command_speed(r).max() == pytest.approx(5.0 / 0.15, rel=1e-9)
+    assert r.command_end_s[0] > 2 * math.sqrt(5.0 / A_RAPID)
     bell = sim("G0 X5")
     assert bell.command_end_s[0] == pytest.approx(r.command_end_s[0] + 0.03 - TI, abs=1e-12)
 
@@ -254,6 +257,16 @@ def test_dwell_and_block_times():
     assert r.block_times_s.sum() == pytest.approx(r.cycle_time_s, abs=1e-9)
     # the second line starts after the first has stopped and the dwell has passed
     assert r.command_end_s[2] == pytest.approx(r.command_end_s[0] + 0.5 + 0.1 + 0.049, abs=1e-9)
+
+
+def test_the_interpolator_carries_the_period_remainder_from_block_to_block():
+    # ten 1.05 mm lines at 100 mm/s are 10.5 periods each: interpolated as one stream they take
+    # 105 periods, where rounding each block up (the paper's eq. 2) would give 110
+    text = "G1 F6000 X1.05\n" + "\n".join(f"X{1.05 * k:.2f}" for k in range(2, 11))
+    r = sim(text, block_time_s=0.0)
+    assert r.command_end_s[-1] == pytest.approx((105 + 50 - 1) * TI, abs=1e-12)
+    assert command_speed(r).max() == pytest.approx(100.0, rel=1e-9)
+    assert r.command_mm[-1, 0] == pytest.approx(10.5, abs=1e-12)
 
 
 # --------------------------------------------------------------------------- the whole run

@@ -165,3 +165,11 @@ def test_main_writes_the_intro_status(book, tmp_path, monkeypatch):
     assert lines[0] == "# Intro" and lines[1] == begin and lines[-1] == end
     assert len(lines) == 2 + 2 + 1  # a line per chapter of the fixture (two)
     assert all(ln.startswith("- **[") for ln in lines[2:4])
+
+
+def test_conditions_that_differ_only_in_numbers_are_named_once_with_their_count():
+    ids = ["inpos_x_set1", "inpos_x_set2", "logger_rate", "table1_cam_F75_P0.3",
+           "table2_cam_F92_P0.4", "table3_pocket_path", "inpos_x_set1"]  # fmt: skip
+    assert verdicts.grouped(ids) == (
+        "inpos_x_set* (2), logger_rate, table*_cam_F*_P* (2), table3_pocket_path"
+    )

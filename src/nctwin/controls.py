@@ -237,7 +237,8 @@ class FanucControl:
         Default 50 1/s on all axes (No. 1825 = 5000): Fanuc's initial value is 3000 (30 1/s);
         tuned ball-screw axes commonly run at 50-80 1/s; the same on every axis because Fanuc
         asks for equal gains on axes that interpolate together (unequal gains distort
-        contours). Not fitted to the paper's in-position times.
+        contours). Not fitted here: the Lee et al. 2022 chapter calibrates the testbed's servo
+        to the paper's in-position times (:mod:`nctwin.chapters.lee2022_testbed`).
     feedforward : float
         Velocity feed-forward coefficient :math:`f` in [0, 1] (No. 2092 / 10000), for both
         servo models. Default 0: Fanuc's feed-forward is enabled with its preview control (AI

@@ -4,11 +4,13 @@ in-position compensation, tested against a Fanuc-like control that is not its ow
 The "measured" machine is :mod:`nctwin.kernel.fanuc` (the ``[control.fanuc]`` table of profile
 ``fanuc_0i_testbed`` with the paper's two parameter sets, :func:`parameter_sets`): a
 time-domain control with acc/dec after interpolation, a block-processing time, an arc clamp,
-bell-shaped rapids and servo loops whose in-position waits come out of the simulation. It
-shares no code with the estimator under test,
-:func:`nctwin.estimate.block_overlap.block_overlap` (the paper's eq. 1-16,
-:mod:`nctwin.methods.lee2022`), but two of its equations: the rounding of each cutting block to
-whole interpolation periods (eq. 2) and the rapid acceleration :math:`F_r/A_{TR}` (eq. 9).
+bell-shaped rapids and servo loops whose in-position waits come out of the simulation, its servo
+and the test piece's passes calibrated to the paper's conditions
+(:mod:`nctwin.chapters.lee2022_testbed`). It shares no code and no equation with the estimator
+under test, :func:`nctwin.estimate.block_overlap.block_overlap` (the paper's eq. 1-16,
+:mod:`nctwin.methods.lee2022`): it carries the period remainder from block to block where eq. 2
+rounds each block, and filters rapids after interpolation where eq. 9-12 price short ones as
+triangles.
 :mod:`nctwin.kernel.accdec`, the ideal machine the estimator was derived for, gives only the
 sanity rows (:func:`ideal_table`).
 
@@ -46,10 +48,11 @@ from ..machine import Machine, load_profile
 from ..methods.lee2022 import check_program
 from ..paths import data_dir
 from ..programs.finishing3d import finishing3d_program, program_statistics
-from ..programs.iso10791 import TEST_PIECE_FILE, test_piece_program
+from ..programs.iso10791 import test_piece_program
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, accuracy_pct, error_pct, load_paper_table
 from ..toolpath import MotionKind, Toolpath
+from .lee2022_testbed import test_piece_params
 from .your_program import ProgramResult, block_feeds, block_summary, program_times, run_program
 
 __all__ = [
@@ -83,7 +86,7 @@ __all__ = [
 TEST_PIECE = "iso10791_7_test_piece"
 FINISHING_3D = "finishing3d"
 #: Each program's file in ``data/programs/``.
-PROGRAM_FILES = {TEST_PIECE: TEST_PIECE_FILE, FINISHING_3D: "finishing3d_seed0.nc"}
+PROGRAM_FILES = {TEST_PIECE: "lee2022_test_piece.nc", FINISHING_3D: "finishing3d_seed0.nc"}
 #: Seed of the shipped 3D finishing program.
 FINISHING_SEED = 0
 #: Real CAM 3D finishing programs (``data/programs/public/``) whose chord lengths the 3D
@@ -94,9 +97,9 @@ REAL_CAM_PROGRAMS = ("LHchips4.ngc", "camotics_bear.nc")
 #: slowest moving axis's time after a rapid) matters only where the axes' times differ as the
 #: paper's do, and the test piece must run as long as the paper's.
 REQUIRES = {
-    "accuracy": ("inpos_x", "inpos_y", "inpos_z", "test_piece_time"),
-    "beats_cam": ("inpos_x", "inpos_y", "inpos_z", "test_piece_time"),
-    "prediction_time": ("test_piece_time",),
+    "accuracy": ("inpos_x", "inpos_y", "inpos_z", "test_piece_time_set{s}"),
+    "beats_cam": ("inpos_x", "inpos_y", "inpos_z", "test_piece_time_set{s}"),
+    "prediction_time": ("test_piece_time_set{s}",),
 }
 #: The estimator's variants: the paper's method and its two ablations (keyword arguments of
 #: :func:`~nctwin.estimate.block_overlap.block_overlap`).
@@ -136,7 +139,7 @@ def program_text(name: str) -> str:
     name : {TEST_PIECE, FINISHING_3D}
     """
     if name == TEST_PIECE:
-        return test_piece_program()
+        return test_piece_program(test_piece_params())
     if name == FINISHING_3D:
         return finishing3d_program(FINISHING_SEED)
     raise ValueError(f"name = {name!r} is out of range: allowed {', '.join(PROGRAM_FILES)}")
@@ -263,13 +266,21 @@ def parameter_sets(
 def measure_inposition(
     machine: Machine, sets: dict[int, tuple[AccDecControl, FanucControl]]
 ) -> dict[int, np.ndarray]:
-    """Each set's in-position times of X, Y, Z (s), measured on the truth as the paper did
-    (:func:`nctwin.kernel.fanuc.measure_inposition_times`: single-axis rapids from rest)."""
-    return {s: fanuc.measure_inposition_times(machine, st) for s, (_, st) in sets.items()}
+    """The in-position times of X, Y, Z (s) the estimator uses with every set: measured once on
+    the truth with the first set, as the paper did (Sec. 3: one measurement, used for both
+    sets; :func:`nctwin.kernel.fanuc.measure_inposition_times`: single-axis rapids from rest)."""
+    once = fanuc.measure_inposition_times(machine, next(iter(sets.values()))[1])
+    return {s: once for s in sets}
 
 
-def inposition_table(inpos: dict[int, np.ndarray], paper_inpos: pd.DataFrame) -> pd.DataFrame:
-    """The in-position times measured on the truth per set and axis, beside the paper's.
+def inposition_table(
+    inpos: dict[int, np.ndarray],
+    paper_inpos: pd.DataFrame,
+    machine: Machine,
+    sets: dict[int, tuple[AccDecControl, FanucControl]],
+) -> pd.DataFrame:
+    """The in-position times the estimator uses per set and axis, beside the paper's and beside
+    what the same measurement gives on the truth with that set's time constants.
 
     Parameters
     ----------
@@ -277,20 +288,21 @@ def inposition_table(inpos: dict[int, np.ndarray], paper_inpos: pd.DataFrame) ->
         ``param_set -> ndarray`` of shape (3,), s (:func:`measure_inposition`).
     paper_inpos : pandas.DataFrame
         The paper table ``lee2022_inposition`` (``axis``, ``inpos_ms``).
+    machine, sets
+        As for :func:`truth_runs`.
 
     Returns
     -------
     pandas.DataFrame
-        ``param_set, axis, inpos_ms, paper_inpos_ms``.
+        ``param_set, axis, inpos_ms, paper_inpos_ms, truth_set_inpos_ms``.
     """
     paper_ms = dict(zip(paper_inpos["axis"], paper_inpos["inpos_ms"], strict=True))
-    return pd.DataFrame(
-        [
-            {"param_set": s, "axis": a, "inpos_ms": 1000 * t[i], "paper_inpos_ms": paper_ms[a]}
-            for s, t in inpos.items()
-            for i, a in enumerate("XYZ")
-        ]
-    )
+    rows = []
+    for s, t in inpos.items():
+        own = fanuc.measure_inposition_times(machine, sets[s][1])
+        rows += [{"param_set": s, "axis": a, "inpos_ms": 1000 * t[i], "paper_inpos_ms": paper_ms[a],
+                  "truth_set_inpos_ms": 1000 * own[i]} for i, a in enumerate("XYZ")]  # fmt: skip
+    return pd.DataFrame(rows)
 
 
 def truth_runs(
@@ -544,7 +556,7 @@ def claims(accuracy: pd.DataFrame, prediction_s: float) -> list[Claim]:
         paper = prog == TEST_PIECE  # Lee et al. claim nothing for 3D programs
 
         def cited(text: str, cite: str, kind: str, _paper=paper, _s=s) -> dict:
-            req = tuple(f"{c}_set{_s}" for c in REQUIRES[kind]) if _paper else ()
+            req = tuple(c.format(s=_s) for c in REQUIRES[kind]) if _paper else ()
             return {"text": f"{text} ({cite})" if _paper else text, "requires": req,
                     "whose": "paper" if _paper else "ours"}  # fmt: skip
 
@@ -565,7 +577,8 @@ def claims(accuracy: pd.DataFrame, prediction_s: float) -> list[Claim]:
     out.append(Claim("prediction_time", f"The estimate of the test piece takes {op} {bar:g} s "
                      f"(wall time read once, rounded up to {res:g} s; {cite})",
                      math.ceil(prediction_s / res) * res, op, bar,
-                     requires=tuple(f"{c}_set1" for c in REQUIRES["prediction_time"])))  # fmt: skip
+                     requires=tuple(c.format(s=1)
+                                    for c in REQUIRES["prediction_time"])))  # fmt: skip
     return out
 
 

@@ -18,35 +18,43 @@ _NEXT, _CUT, _DRAIN_CUT, _RAPIDS, _DRAIN_RAPID, _INPOS, _PAUSE, _DONE = range(8)
 
 
 @njit(cache=True)
-def _start_rapid(slot, blk, start, end, linear, rem, vel, dirs):  # pragma: no cover - compiled
-    """Load rapid block ``blk`` into planner slot ``slot``: one planner along the line (linear
-    type) or one per axis (non-linear type). Returns whether it has anything to move."""
-    rem[slot, :] = 0.0
-    vel[slot, :] = 0.0
-    dirs[slot, :, :] = 0.0
+def _start_rapid(blk, start, end, linear, rem, dirs):  # pragma: no cover - compiled
+    """Load rapid block ``blk`` into the rapid interpolator: one distance along the line
+    (linear type) or one per axis (non-linear type). Returns whether it has anything to move."""
+    rem[:] = 0.0
+    dirs[:, :] = 0.0
     d0 = end[blk, 0] - start[blk, 0]
     d1 = end[blk, 1] - start[blk, 1]
     d2 = end[blk, 2] - start[blk, 2]
     if linear:
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         if length > 0.0:
-            rem[slot, 0] = length
-            dirs[slot, 0, 0] = d0 / length
-            dirs[slot, 0, 1] = d1 / length
-            dirs[slot, 0, 2] = d2 / length
+            rem[0] = length
+            dirs[0, 0] = d0 / length
+            dirs[0, 1] = d1 / length
+            dirs[0, 2] = d2 / length
     else:
         for a in range(3):
             d = end[blk, a] - start[blk, a]
-            rem[slot, a] = abs(d)
-            dirs[slot, a, a] = 1.0 if d >= 0.0 else -1.0
-    return rem[slot, 0] > 0.0 or rem[slot, 1] > 0.0 or rem[slot, 2] > 0.0
+            rem[a] = abs(d)
+            dirs[a, a] = 1.0 if d >= 0.0 else -1.0
+    return rem[0] > 0.0 or rem[1] > 0.0 or rem[2] > 0.0
+
+
+@njit(cache=True, inline="always")
+def _box(total, buf, at, a, x, k):  # pragma: no cover - compiled
+    """One period of a moving average of ``k`` periods on axis ``a``: ``x`` in, the mean out
+    (``total`` the running sum, ``buf`` the last ``k`` inputs, ``at`` the oldest's row)."""
+    total[a] += x - buf[at, a]
+    buf[at, a] = x
+    return total[a] / k
 
 
 # fmt: off
 @njit(cache=True)
 def control_loop(
-    kind, start, end, cut_pts, cut_off, drain_after, stop_after, pause_n,
-    ti, rapid_feed, rapid_acc, k_bell, linear_rapid, overlap, overlap_feed,
+    kind, start, end, cut_steps, cut_off, drain_after, stop_after, pause_n,
+    ti, rapid_feed, k_rapid, k_bell, linear_rapid, overlap, overlap_feed,
     exp_cut, k1, k2, exp_keep, exp_gain, unit,
     ad, bd, width,
     cmd_out, pos_out, blk_out, wait_out, end_out,
@@ -56,27 +64,24 @@ def control_loop(
     # fmt: on
     n_blocks = len(kind)
     cap = len(blk_out)
-    buf1 = np.zeros((k1, 3))
+    buf1 = np.zeros((k1, 3))  # cutting acc/dec: two moving averages
     buf2 = np.zeros((k2, 3))
+    bufr = np.zeros((k_rapid, 3))  # rapid acc/dec: T_R, then the bell T_S
     bufb = np.zeros((k_bell, 3))
     sum1 = np.zeros(3)
     sum2 = np.zeros(3)
+    sumr = np.zeros(3)
     sumb = np.zeros(3)
-    i1 = i2 = ib = 0
+    i1 = i2 = ir = ib = 0
     resid = np.zeros(3)  # exponential filter: distance still inside it
-    rem = np.zeros((2, 3))  # rapid planners: two slots (current, previous) of up to 3
-    vel = np.zeros((2, 3))
-    dirs = np.zeros((2, 3, 3))
-    act = np.zeros(2, np.bool_)
-    cur = 0
-    decel = False
-    feed_prev = 0.0
-    feed_cur = 0.0
+    rem = np.zeros(3)  # rapid interpolator: distance left (along the line, or per axis)
+    dirs = np.zeros((3, 3))
+    rapid_speed = 0.0  # path speed out of the rapid filters in the last period (never rises
+    # once a rapid is interpolated)
     err = np.zeros((3, 2))  # servo state per axis: following error, actual velocity
     cmd = np.zeros(3)
     if n_blocks:
         cmd[:] = start[0]
-    interp = cmd.copy()
     xc = np.zeros(3)
     xr = np.zeros(3)
     i = 0
@@ -102,13 +107,9 @@ def control_loop(
             if kind[b] == _DWELL:
                 phase = _PAUSE
             elif kind[b] == _RAPID:
-                cur = 0
-                act[0] = _start_rapid(0, b, start, end, linear_rapid, rem, vel, dirs)
-                act[1] = False
-                decel, feed_prev, feed_cur = False, 0.0, 0.0
+                _start_rapid(b, start, end, linear_rapid, rem, dirs)
                 phase = _RAPIDS
             else:
-                interp[:] = start[b]
                 phase = _CUT
             continue
         elif phase == _CUT:
@@ -121,8 +122,7 @@ def control_loop(
                 continue
             p = cut_off[b] + j
             for a in range(3):
-                xc[a] = cut_pts[p, a] - interp[a]
-                interp[a] = cut_pts[p, a]
+                xc[a] = cut_steps[p, a]
             j += 1
             last_cut = i + 1
         elif phase == _DRAIN_CUT:
@@ -145,57 +145,31 @@ def control_loop(
                 continue
             flush = exp_cut
         elif phase == _RAPIDS:
-            other = 1 - cur
-            if (
-                overlap
-                and b + 1 < n_blocks
-                and kind[b + 1] == _RAPID
-                and not act[other]
-                and (not act[cur] or (decel and feed_cur <= overlap_feed))
-            ):
-                cur = other
-                b += 1
-                act[cur] = _start_rapid(cur, b, start, end, linear_rapid, rem, vel, dirs)
-                decel, feed_prev, feed_cur = False, 0.0, 0.0
-                continue
-            if not act[0] and not act[1]:
-                phase = _DRAIN_RAPID
-                continue
-            for s in range(2):
-                if not act[s]:
-                    continue
-                fmax = 0.0
-                left = False
-                for q in range(3):
-                    r = rem[s, q]
-                    if r <= 0.0:
+            if rem[0] <= 0.0 and rem[1] <= 0.0 and rem[2] <= 0.0:
+                # interpolated: with rapid overlap, the next rapid starts once the filters'
+                # output has braked to overlap_feed; else the filters empty and the axes settle
+                if overlap and b + 1 < n_blocks and kind[b + 1] == _RAPID:
+                    if rapid_speed <= overlap_feed:
+                        b += 1
+                        _start_rapid(b, start, end, linear_rapid, rem, dirs)
                         continue
-                    # fastest speed from which braking at rapid_acc still stops on the end
-                    # point, braking by rapid_acc * ti every period
-                    v_brake = rapid_acc * (math.sqrt(0.25 * ti * ti + 2.0 * r / rapid_acc)
-                                           - 0.5 * ti)  # fmt: skip
-                    v = min(vel[s, q] + rapid_acc * ti, rapid_feed, v_brake)
-                    step = v * ti
-                    if step >= r:
-                        step = r
-                        rem[s, q] = 0.0
-                        vel[s, q] = 0.0
-                    else:
-                        rem[s, q] = r - step
-                        vel[s, q] = v
-                        left = True
-                        fmax = max(fmax, v)
+                else:
+                    phase = _DRAIN_RAPID
+                    continue
+            else:
+                for q in range(3):  # one period at F_r, the remainder in the last one
+                    step = rapid_feed * ti
+                    if rem[q] - step <= 1e-9:  # the rest, forgiving round-off
+                        step = rem[q]
+                    rem[q] -= step
                     for a in range(3):
-                        xr[a] += step * dirs[s, q, a]
-                act[s] = left
-                if s == cur:
-                    decel = fmax < feed_prev
-                    feed_cur = fmax
-                    feed_prev = fmax
-            last_rap = i + 1
+                        xr[a] += step * dirs[q, a]
+                last_rap = i + 1
         elif phase == _DRAIN_RAPID:
-            if last_rap < 0 or i >= last_rap + k_bell - 1:
+            if last_rap < 0 or i >= last_rap + k_rapid + k_bell - 2:
+                bufr[:, :] = 0.0
                 bufb[:, :] = 0.0
+                sumr[:] = 0.0
                 sumb[:] = 0.0
                 last_rap = -1
                 end_out[b] = i * ti
@@ -228,6 +202,7 @@ def control_loop(
             return -1
         i += 1
         small = True
+        speed2 = 0.0
         for a in range(3):
             if exp_cut:
                 r0 = resid[a]
@@ -235,20 +210,16 @@ def control_loop(
                 oc = xc[a] + r0 - resid[a]
                 small = small and abs(resid[a]) <= unit
             else:
-                sum1[a] += xc[a] - buf1[i1, a]
-                buf1[i1, a] = xc[a]
-                y = sum1[a] / k1
-                sum2[a] += y - buf2[i2, a]
-                buf2[i2, a] = y
-                oc = sum2[a] / k2
-            sumb[a] += xr[a] - bufb[ib, a]
-            bufb[ib, a] = xr[a]
-            d_cmd = oc + sumb[a] / k_bell
+                oc = _box(sum2, buf2, i2, a, _box(sum1, buf1, i1, a, xc[a], k1), k2)
+            orap = _box(sumb, bufb, ib, a, _box(sumr, bufr, ir, a, xr[a], k_rapid), k_bell)
+            speed2 += orap * orap
+            d_cmd = oc + orap
             cmd[a] += d_cmd
             v_cmd = d_cmd / ti
             e, w = err[a, 0], err[a, 1]
             err[a, 0] = ad[a, 0, 0] * e + ad[a, 0, 1] * w + bd[a, 0] * v_cmd
             err[a, 1] = ad[a, 1, 0] * e + ad[a, 1, 1] * w + bd[a, 1] * v_cmd
+        rapid_speed = math.sqrt(speed2) / ti
         if flush and small:  # the exponential tail: less than one increment left
             for a in range(3):
                 cmd[a] += resid[a]
@@ -256,6 +227,7 @@ def control_loop(
                 resid[a] = 0.0
         i1 = (i1 + 1) % k1
         i2 = (i2 + 1) % k2
+        ir = (ir + 1) % k_rapid
         ib = (ib + 1) % k_bell
         for a in range(3):
             cmd_out[i, a] = cmd[a]

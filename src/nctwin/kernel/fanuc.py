@@ -4,21 +4,29 @@ The chapter on Lee et al. 2022 (J. Korean Soc. Precis. Eng. 39(7), 537-543; a Fa
 three-axis testbed) tests an analytic cycle-time estimate against a machine. This kernel is that
 machine. It shares no code with the estimate, and no block's time is computed here: every time
 comes out of a loop that advances the control one interpolation period :math:`T_I` at a time, as
-the control does, and counts the periods. It shares two of the estimate's equations, though: each
-cutting block is rounded up to whole periods, :math:`\max(\lceil l/(F T_I) \rceil,
-\lceil t_b/T_I \rceil)` periods (the paper's eq. 2, :func:`simulate`), with no remainder carried
-into the next block; and the rapid acceleration is :math:`F_r / A_{TR}` (eq. 9).
+the control does, and counts the periods. It shares none of the estimate's equations either: no
+block is rounded to whole periods (the paper's eq. 2), because the interpolator carries the
+remainder of a period from one block into the next; and a rapid is interpolated at
+:math:`F_r` and smoothed by acc/dec after interpolation, so a rapid shorter than
+:math:`F_r A_{TR}` becomes a slow flat-topped profile that lasts :math:`l/F_r + A_{TR}`,
+where the paper's eq. 9-12 price it as a triangle at the acceleration :math:`F_r/A_{TR}`
+(shorter). The two agree on a long rapid, whose acceleration is :math:`F_r/T_R` by the
+definition of the time constant.
 
 What one period does
 --------------------
 Interpolator (cutting feed: G1, G2, G3)
-    Each block is distributed at its feed :math:`v_k` along the path, one period at a time
-    (:math:`v_k T_I` of arc length per period, the rest in the block's last period); the next
-    cutting block starts in the next period. :math:`v_k` is the programmed F, clamped by the
+    Consecutive cutting blocks, up to a stop, are distributed as one stream: block :math:`k`
+    lasts :math:`l_k / v_k` at its feed :math:`v_k` along the path, and the point at the end of
+    every period is read off the path, so a period that straddles a junction carries the end of
+    one block and the start of the next (Fanuc's pulse distribution works on the remainder of
+    the period; nothing is rounded per block). Only a stop ends a period on a block's end point.
+    :math:`v_k` is the programmed F, clamped by the
     machine's maximum feed and by what its axis velocities allow along the block
     (:func:`nctwin.limits.path_limits`), by the *feedrate clamp by arc radius* on arcs
     (:math:`v \le \sqrt{a_r R}`, Fanuc No. 1730/1731) and by the *block-processing time*
-    :math:`t_b` (a block lasts at least :math:`t_b`: :math:`v \le l / t_b`).
+    :math:`t_b` (a block lasts at least :math:`t_b`: :math:`v \le l / t_b`; a block of no
+    length lasts :math:`t_b`).
 Acc/dec after interpolation (cutting feed)
     The interpolated displacement of every axis passes through a filter, period by period
     (``cut_accdec``): *linear*, a moving average over :math:`T` (``cut_time_constant_s``);
@@ -29,13 +37,15 @@ Acc/dec after interpolation (cutting feed)
     cutting blocks overlap by themselves at every junction and corners are rounded: nothing
     decides an overlap.
 Rapids (G0)
-    A rapid starts once everything before it has stopped. Its interpolator accelerates at the
-    constant :math:`a = F_r / T_R` (the acceleration No. 1420 and No. 1620 set), cruises at
-    :math:`F_r` and brakes so as to stop on the end point, decided period by period from the
-    distance left; *linear* type moves along the straight line at path speed :math:`F_r`,
-    *non-linear* type runs one such interpolator per axis (Lee et al. 2022, Fig. 3). A moving
-    average over :math:`T_S` (``rapid_bell_s``, No. 1621) makes the profile bell-shaped. With
-    ``rapid_overlap`` (No. 1601#4 RTO) the next rapid starts once the current one has braked to
+    A rapid starts once everything before it has stopped. Its interpolator steps at :math:`F_r`
+    (:math:`F_r T_I` per period, the rest in the last one); *linear* type moves along the
+    straight line at path speed :math:`F_r`, *non-linear* type steps each axis on its own at
+    :math:`F_r` (Lee et al. 2022, Fig. 3). Acc/dec after interpolation (Fanuc's linear or bell
+    type for rapid traverse) smooths the steps: a moving average over :math:`T_R` (No. 1620),
+    then one over :math:`T_S` (``rapid_bell_s``, No. 1621), so a long rapid accelerates at
+    :math:`F_r/T_R` with its jerk spread over :math:`T_S` and lasts
+    :math:`l/F_r + T_R + T_S`. With ``rapid_overlap`` (No. 1601#4 RTO) the next rapid starts
+    once the current one is interpolated and the filters' output has braked to
     ``rapid_overlap_percent`` of :math:`F_r` (No. 1722), and no in-position check separates them.
 Servo
     Each axis follows the command through a position loop with velocity feed-forward
@@ -199,6 +209,51 @@ def _ceil(x: np.ndarray) -> np.ndarray:
     return np.ceil(np.asarray(x, dtype=float) - 1e-9).astype(np.int64)
 
 
+def _interpolate(
+    tp: Toolpath, duration_s: np.ndarray, cut: np.ndarray, drain_after: np.ndarray, ti: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The interpolator's output for the cutting blocks: one displacement per period.
+
+    Consecutive cutting blocks up to a stop (``drain_after``) form a chain, interpolated as one
+    stream: block :math:`k` occupies :math:`d_k` of the chain's time (``duration_s``, at its
+    feed, constant along it), and the point at the end of every period is read off the path,
+    so a period that straddles a junction carries the end of one block and the start of the
+    next (the remainder is carried, no block is rounded to whole periods); only the chain's
+    last period ends on its end point.
+
+    Returns
+    -------
+    steps : ndarray, shape (P, 3)
+        Displacement of each period, chains one after another.
+    periods : ndarray, shape (N,)
+        Periods credited to each block (a period to the block its end falls in); 0 for blocks
+        that are not cutting blocks.
+    """
+    n = len(tp)
+    periods = np.zeros(n, np.int64)
+    steps = []
+    geo = PathGeometry(tp)
+    ends = np.flatnonzero(drain_after)
+    starts = np.concatenate([[0], ends[:-1] + 1]) if len(ends) else np.zeros(0, np.int64)
+    for first, last in zip(starts, ends, strict=True):
+        first = first + int(np.argmax(cut[first : last + 1]))  # skip rapids and dwells
+        t_end = np.cumsum(duration_s[first : last + 1])
+        count = int(_ceil(t_end[-1] / ti)) if t_end[-1] > 0 else 0
+        t = np.minimum(np.arange(1, count + 1) * ti, t_end[-1])
+        k = np.minimum(np.searchsorted(t_end, t - 1e-12 * ti), last - first)
+        t0 = t_end[k] - duration_s[first + k]
+        frac = np.where(duration_s[first + k] > 0, (t - t0) / duration_s[first + k], 1.0)
+        s0, s1 = geo.s_start_mm[first + k], geo.s_start_mm[first + k + 1]
+        s_at = np.where(
+            t >= t_end[-1], geo.s_start_mm[last + 1], s0 + np.clip(frac, 0, 1) * (s1 - s0)
+        )
+        pts = geo.points(s_at) if count else np.zeros((0, 3))
+        steps.append(np.diff(pts, axis=0, prepend=tp.start_mm[first][None, :]))
+        periods[first : last + 1] = np.bincount(k, minlength=last - first + 1)
+    out = np.concatenate(steps) if steps else np.zeros((0, 3))
+    return np.ascontiguousarray(out), periods
+
+
 def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER_SET_1) -> FanucRun:
     """Run a program on the Fanuc-like control, one interpolation period at a time.
 
@@ -244,24 +299,15 @@ def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER
         if s.block_time_s > 0:
             feed = np.minimum(feed, lengths / s.block_time_s)
         feed = np.where(cut & (lengths > 0), feed, np.nan)
-        periods = np.where(lengths > 0, lengths / (feed * ti), 0.0)
-    periods = np.maximum(_ceil(np.nan_to_num(periods)), _ceil(s.block_time_s / ti))
-    periods = np.where(cut, periods, 0)
-    cut_off = np.concatenate([[0], np.cumsum(periods)]).astype(np.int64)
-    # ---- interpolated points of every period of every cutting block
-    geo = PathGeometry(tp)
-    owner = np.repeat(np.arange(n), periods)
-    j = np.arange(len(owner)) - cut_off[owner]
-    step_mm = np.where(lengths > 0, np.nan_to_num(feed) * ti, 0.0)  # arc length per period
-    arc_len = np.minimum((j + 1) * step_mm[owner], lengths[owner])
-    last = j == periods[owner] - 1
-    s_at = np.where(last, geo.s_start_mm[owner + 1], geo.s_start_mm[owner] + arc_len)
-    cut_pts = geo.points(s_at) if len(s_at) else np.zeros((0, 3))
+        duration = np.where(lengths > 0, lengths / feed, s.block_time_s)
+    duration = np.where(cut, duration, 0.0)
     # ---- where the control stops: before rapids and dwells, in exact-stop mode, at the end
     exact = tp.path_mode >= PathMode.EXACT_PATH
     next_cut = np.append(cut[1:], False)
     drain_after = cut & (~next_cut | exact)
     stop_after = cut & exact
+    cut_steps, periods = _interpolate(tp, duration, cut, drain_after, ti)
+    cut_off = np.concatenate([[0], np.cumsum(periods)]).astype(np.int64)
     pause_n = np.where(kind == MotionKind.DWELL, _ceil(tp.dwell_s / ti), 0)
     # ---- filters and servo
     k_cut = s.periods("cut_time_constant_s")
@@ -271,7 +317,7 @@ def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER
     exp_keep = math.exp(-ti / s.cut_time_constant_s)
     exp_gain = s.cut_time_constant_s / ti * (1.0 - exp_keep)
     fr = machine.rapid_feed_mm_s
-    rapid_acc = fr / s.rapid_time_constant_s
+    k_rapid = s.periods("rapid_time_constant_s")
     ad, bd = _servo_matrices(s)
     width = np.asarray(s.inposition_width_mm)
     # ---- a first guess of the number of samples; doubled until the run fits
@@ -300,8 +346,8 @@ def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER
         wait = np.zeros(n)
         cmd_end = np.full(n, np.nan)
         count = _fanuc_loops.control_loop(
-            kind, start, end, np.ascontiguousarray(cut_pts), cut_off, drain_after, stop_after,
-            pause_n.astype(np.int64), ti, fr, rapid_acc, k_bell, s.rapid_type == "linear",
+            kind, start, end, cut_steps, cut_off, drain_after, stop_after,
+            pause_n.astype(np.int64), ti, fr, k_rapid, k_bell, s.rapid_type == "linear",
             s.rapid_overlap, s.rapid_overlap_percent / 100.0 * fr, exp_cut, k1, k2, exp_keep,
             exp_gain, s.least_increment_mm, ad, bd, width, cmd, pos, blk, wait, cmd_end,
         )  # fmt: skip
@@ -327,6 +373,7 @@ def measure_inposition_times(
     control: FanucControl = PAPER_SET_1,
     *,
     distances_mm: tuple[float, ...] = (20.0, 50.0, 100.0, 150.0, 200.0),
+    axes: tuple[int, ...] = (0, 1, 2),
 ) -> np.ndarray:
     """Each axis's in-position time, measured as Lee et al. 2022 did (Sec. 2.3 and 3).
 
@@ -341,11 +388,13 @@ def measure_inposition_times(
     control : FanucControl
     distances_mm : tuple of float
         Travels of the measured rapids, each > 0.
+    axes : tuple of int
+        The axes measured (0, 1, 2 for X, Y, Z).
 
     Returns
     -------
     ndarray, shape (3,)
-        Mean in-position time of X, Y, Z (s).
+        Mean in-position time of X, Y, Z (s); NaN for an axis not measured.
 
     Raises
     ------
@@ -357,10 +406,13 @@ def measure_inposition_times(
         raise ValueError(
             f"distances_mm = {distances_mm!r} is out of range: allowed one or more numbers > 0"
         )
-    out = np.zeros(3)
+    if not set(axes) <= {0, 1, 2}:
+        raise ValueError(f"axes = {axes!r} is out of range: allowed 0, 1, 2 (X, Y, Z)")
+    out = np.full(3, np.nan)
+    out[list(axes)] = 0.0
     nan3 = np.full((1, 3), np.nan)
     z1 = np.zeros(1)
-    for a in range(3):
+    for a in axes:
         for x in dist:
             end = np.zeros((1, 3))
             end[0, a] = x

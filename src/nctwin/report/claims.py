@@ -28,7 +28,7 @@ import pandas as pd
 
 from .conditions import Condition
 from .tables import OPS, Claim, format_table, write_claims
-from .verdicts import status_of
+from .verdicts import grouped, status_of
 
 __all__ = [
     "LINE",
@@ -74,7 +74,7 @@ def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VER
         text += f"  [interval {claim.interval[0]:.3g} to {claim.interval[1]:.3g}]"
     if claim.seeds is not None:
         text += f"  [{claim.seeds_passing} of {claim.seeds} single networks pass]"
-    return text + (f"  [unmet: {', '.join(claim.unmet)}]" if claim.unmet else "")
+    return text + (f"  [unmet: {grouped(claim.unmet)}]" if claim.unmet else "")
 
 
 def report_claims(

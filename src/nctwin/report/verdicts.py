@@ -192,6 +192,20 @@ def _status(record: dict) -> str:
     return record.get("status") or ("holds" if record["holds"] else "fails")
 
 
+def grouped(ids: list[str]) -> str:
+    """Condition ids for a sentence: ids that differ only in their numbers are one entry, the
+    numbers as ``*`` and the count after it (``pocket*_cam_err (8)``); the rest as they are.
+
+    >>> grouped(["pocket2_cam_err", "logger_rate", "pocket1_cam_err", "pocket1_cls"])
+    'logger_rate, pocket*_cam_err (2), pocket1_cls'
+    """
+    families: dict[str, list[str]] = {}
+    for i in sorted(set(ids)):
+        families.setdefault(re.sub(r"\d+(?:\.\d+)?", "*", i), []).append(i)
+    entries = [m[0] if len(m) == 1 else f"{key} ({len(m)})" for key, m in families.items()]
+    return ", ".join(sorted(entries))
+
+
 def status_of(records: list[dict]) -> tuple[str, str]:
     """A chapter's status (one of :data:`STATUSES`) and one sentence of why, from its claims'
     records (:meth:`~nctwin.report.tables.Claim.to_dict`).
@@ -205,9 +219,9 @@ def status_of(records: list[dict]) -> tuple[str, str]:
     if not paper:
         return STATUSES[4], f"The chapter's {len(records)} claims are checks of our own."
     count = {k: sum(_status(r) == k for r in paper) for k in ("holds", "fails", "not tested")}
-    unmet = sorted({u for r in paper for u in r.get("unmet", [])})
+    unmet = [u for r in paper for u in r.get("unmet", [])]
     why = (f"{count['holds']} of the paper's {len(paper)} claims hold, {count['fails']} fail"
-           + (f", {count['not tested']} not tested (unmet: {', '.join(unmet)})"
+           + (f", {count['not tested']} not tested (unmet: {grouped(unmet)})"
               if count["not tested"] else "") + ".")  # fmt: skip
     if count["not tested"] == len(paper):
         status = STATUSES[3]
@@ -309,7 +323,7 @@ def render(chapters: list[ChapterClaims]) -> str:
             target = f"notebooks/{chapter.stem}.ipynb" + (f"#{slug}" if slug else "")
             status = _status(r)
             verdict = _VERDICT_HTML[status] + (
-                f" (unmet: {', '.join(r['unmet'])})" if status == "not tested" else ""
+                f" (unmet: {grouped(r['unmet'])})" if status == "not tested" else ""
             )
             lines.append(
                 f"| {_cell(r['text'])} (`{_cell(r['id'])}`) | {r.get('whose', 'paper')} "
