@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -78,14 +80,20 @@ def test_eq9_eq10_by_hand(triangle_run):
     assert target_time(run, "true") == pytest.approx(run.measured_s, rel=0.01)
 
 
-def test_the_ensemble_averages_the_seeds_feeds(triangle_run):
+def test_the_ensemble_averages_the_seeds_times(triangle_run):
     from nctwin.chapters.sun2022 import predict_time
 
-    # seeds predicting (2, 4, 0) and (4, 4, 0) average to (3, 4, 0): 5 mm/s, 14 s, not the
-    # mean of the seeds' times (70 / sqrt(20) and 70 / sqrt(32))
+    # 70 mm: seeds predicting (2, 4, 0) and (4, 4, 0) mm/s take 70 / sqrt(20) and 70 / sqrt(32) s;
+    # the ensemble takes the mean of the two times
     a = [_Constant(2.0), _Constant(4.0), _Constant(0.0)]
     b = [_Constant(4.0), _Constant(4.0), _Constant(0.0)]
-    assert predict_time([a, b], triangle_run)[0] == pytest.approx(14.0)
+    both = 0.5 * (70 / math.sqrt(20) + 70 / math.sqrt(32))
+    assert predict_time([a, b], triangle_run)[0] == pytest.approx(both)
+    # seeds that agree on speed but not on direction: (4, 0, 0) and (0, 4, 0) both take 17.5 s,
+    # where their mean vector (2, 2, 0) would be 2.83 mm/s, 24.7 s
+    c = [_Constant(4.0), _Constant(0.0), _Constant(0.0)]
+    d = [_Constant(0.0), _Constant(4.0), _Constant(0.0)]
+    assert predict_time([c, d], triangle_run)[0] == pytest.approx(17.5)
 
 
 def test_models_are_table2():

@@ -4,8 +4,9 @@ axis predicts the axis feeds at every cutter location, and from them the machini
 The chapter's pipeline, kept out of the notebook:
 
 1. :func:`run_pockets` runs the eight pocket programs of :mod:`nctwin.programs.thinwall` on the
-   FIR kernel (the "machine"), records each at about 5 Hz with jitter (the paper's measuring
-   device), and pairs every cutter location with the nearest record (the paper's targets). It
+   FIR kernel (the "machine"), records each at the paper's logger rate with jitter (its measuring
+   device, records per second as ``data/papers/sun2022_summary.csv`` gives them for pocket
+   1), and pairs every cutter location with the nearest record (the paper's targets). It
    also keeps the block-average axis feeds at each cutter location (1 kHz), which the paper did
    not have. :func:`part_stats` and :func:`machine_check` put the part and the machine beside
    the paper's published statistics.
@@ -13,8 +14,8 @@ The chapter's pipeline, kept out of the notebook:
    5 and 10, linear output, MSE) on the training pockets of Table 2 (:data:`MODELS`), validating
    on the first half of pocket 4, once per seed of :data:`SEEDS`, the seeds in parallel through
    :func:`nctwin.runner.run_tasks`.
-3. :func:`predict_time` averages the seeds' predicted axis feeds (the ensemble) and turns them
-   into the resultant feed (eq. 9) and the machining time (eq. 10).
+3. :func:`predict_time` turns each seed's predicted axis feeds into the resultant feed (eq. 9)
+   and block times (eq. 10); the ensemble's time is the mean of the seeds' times.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ TRAIN_CONFIG = TrainConfig(
     loss="mse", window_lines=256, batch_size=8, max_epochs=3000, patience=50, learning_rate=1e-2
 )
 
-#: Targets: the record nearest to each cutter location (the paper's, ~5 Hz), or the 1 kHz
+#: Targets: the record nearest to each cutter location (the paper's logger), or the 1 kHz
 #: block-average axis feed (an ablation the paper could not run).
 TARGETS = ("measured", "true")
 
@@ -95,7 +96,7 @@ class PocketRun:
     motion : Motion
         The machine's motion (1 ms).
     records : ControllerSamples
-        What the 5 Hz logger recorded.
+        What the logger recorded.
     features : ndarray, shape (N, 3, 9)
         :func:`nctwin.methods.sun2022.features`.
     measured_feed_mm_s : ndarray, shape (N, 3)
@@ -128,7 +129,8 @@ class PocketRun:
         return self.motion.cycle_time_s
 
     def target(self, target: str) -> np.ndarray:
-        """The axis-feed targets, shape (N, 3): ``"measured"`` (5 Hz) or ``"true"`` (1 kHz)."""
+        """The axis-feed targets, shape (N, 3): ``"measured"`` (the logger's) or ``"true"``
+        (1 kHz)."""
         if target not in TARGETS:
             raise ValueError(f"target = {target!r} is unknown: allowed {', '.join(TARGETS)}")
         return self.measured_feed_mm_s if target == "measured" else self.true_feed_mm_s
@@ -352,10 +354,14 @@ def predict_all_feeds(members: list[list[Trained]], runs: list[PocketRun]) -> li
 
 
 def predict_time(members: list[list[Trained]], run: PocketRun) -> tuple[float, np.ndarray]:
-    """Machining time from the predicted axis feeds (eq. 9-10, every block, rapids included).
+    """Machining time of the ensemble (eq. 9-10, every block, rapids included).
 
-    Returns the time (s) and the resultant feed at each cutter location, shape (N,)
-    (:func:`nctwin.methods.sun2022.resultant_feed_mm_s`).
+    Each member (seed) turns its axis feeds into block times (eq. 9-10); the ensemble's block
+    time is the mean of the members' times, not the time of their mean feed vector (whose
+    resultant is shorter than every member's where the members disagree on direction).
+
+    Returns the time (s) and the ensemble's resultant feed at each cutter location, the block's
+    length over its mean time, shape (N,).
     """
     return predict_times(members, [run])[0]
 
@@ -364,10 +370,13 @@ def predict_times(
     members: list[list[Trained]], runs: list[PocketRun]
 ) -> list[tuple[float, np.ndarray]]:
     """:func:`predict_time` of several pockets, each network run once over all of them."""
+    per_member = [predict_all_feeds([m], runs) for m in members]
     out = []
-    for run, feeds in zip(runs, predict_all_feeds(members, runs), strict=True):
-        t = sun.block_times_s(feeds, run.toolpath.lengths_mm, run.commanded_mm_s)
-        out.append((float(t.sum()), sun.resultant_feed_mm_s(feeds, run.commanded_mm_s)))
+    for k, run in enumerate(runs):
+        lengths = run.toolpath.lengths_mm
+        t = np.mean([sun.block_times_s(feeds[k], lengths, run.commanded_mm_s)
+                     for feeds in per_member], axis=0)  # fmt: skip
+        out.append((float(t.sum()), lengths / t))
     return out
 
 
@@ -387,7 +396,7 @@ def time_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.D
 
 def seed_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.DataFrame:
     """Per pocket, each seed's signed error (``seed_<s>_err_pct``), the ensemble's
-    (``ensemble_err_pct``: the mean of the seeds' feeds through eq. 9-10, the reported network)
+    (``ensemble_err_pct``: the mean of the seeds' times, eq. 9-10, the reported network)
     and the spread of the seeds (mean, standard deviation, min, max)."""
     rows = []
     for k, run in runs.items():
@@ -466,12 +475,12 @@ def error_sources(
     """Per pocket and target: the bias of the target definition (eq. 10 fed with the targets;
     ``bias_<t>_err_pct``), the share of it in the rapids (``bias_<t>_rapids_s``: the targets'
     rapid time minus the machine's) and the ensembles' errors (``m1_<t>_err_pct``,
-    ``m2_<t>_err_pct``); ``<t>`` is ``5hz`` or ``1khz``."""
+    ``m2_<t>_err_pct``); ``<t>`` is ``logger`` or ``1khz``."""
     rows = []
     for k, run in runs.items():
         row = {"pocket": k, "measured_s": run.measured_s}
         rapid = np.isin(run.motion.block, np.flatnonzero(run.toolpath.kind == MotionKind.RAPID))
-        for target, label in (("measured", "5hz"), ("true", "1khz")):
+        for target, label in (("measured", "logger"), ("true", "1khz")):
             row[f"bias_{label}_err_pct"] = error_pct(
                 target_time(run, target), run.measured_s, signed=True
             )

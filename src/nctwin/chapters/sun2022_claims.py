@@ -122,8 +122,7 @@ def seed_feeds(ensembles: dict[str, list[list[Trained]]], runs: list[PocketRun])
     Returns
     -------
     ndarray, shape (n_seeds, n_models, N, 3)
-        The mean over axis 0 is the ensemble's feeds (:func:`~nctwin.chapters.sun2022.
-        predict_all_feeds`).
+        :func:`outcome` makes the ensemble's times of them.
     """
     per_model = [[np.concatenate(predict_all_feeds([m], runs)) for m in members]
                  for members in ensembles.values()]  # fmt: skip
@@ -131,13 +130,15 @@ def seed_feeds(ensembles: dict[str, list[list[Trained]]], runs: list[PocketRun])
 
 
 def outcome(feeds: np.ndarray, runs: list[PocketRun]) -> dict[str, np.ndarray]:
-    """The errors the claims read, from one set of axis feeds per model.
+    """The errors the claims read, from the axis feeds of an ensemble's seeds, per model: each
+    seed's feeds give block times (eq. 9-10), the ensemble's block time is their mean
+    (:func:`~nctwin.chapters.sun2022.predict_times`).
 
     Parameters
     ----------
-    feeds : ndarray, shape (n_models, N, 3)
+    feeds : ndarray, shape (n_seeds, n_models, N, 3)
         Axis feeds at every cutter location of ``runs`` (concatenated), models in the order
-        of :func:`seed_feeds`.
+        of :func:`seed_feeds`; one seed for a single network.
     runs : list of PocketRun
         Pockets 1 to 8, in order.
 
@@ -149,11 +150,14 @@ def outcome(feeds: np.ndarray, runs: list[PocketRun]) -> dict[str, np.ndarray]:
         model's predicted minus measured time over the rapids of pocket :data:`G0_POCKET`.
     """
     split = np.cumsum([len(r.toolpath) for r in runs])[:-1]
-    err = np.empty((len(feeds), len(runs)))
-    g0 = np.empty(len(feeds))
-    for m, model_feeds in enumerate(feeds):
-        for k, (run, f) in enumerate(zip(runs, np.split(model_feeds, split), strict=True)):
-            t = sun.block_times_s(f, run.toolpath.lengths_mm, run.commanded_mm_s)
+    n_models = feeds.shape[1]
+    err = np.empty((n_models, len(runs)))
+    g0 = np.empty(n_models)
+    for m in range(n_models):
+        per_seed = [np.split(f, split) for f in feeds[:, m]]
+        for k, run in enumerate(runs):
+            t = np.mean([sun.block_times_s(f[k], run.toolpath.lengths_mm, run.commanded_mm_s)
+                         for f in per_seed], axis=0)  # fmt: skip
             err[m, k] = error_pct(float(t.sum()), run.measured_s)
             if k + 1 == G0_POCKET:
                 rapid = run.toolpath.kind == MotionKind.RAPID
@@ -197,14 +201,14 @@ def _specs() -> list[tuple[str, str, str, float, Callable[[dict], float], tuple[
 def claims(
     feeds: np.ndarray, runs: list[PocketRun], sources: pd.DataFrame, table3: pd.DataFrame
 ) -> list[Claim]:
-    """The paper's claims of Sec. 4 on the 5 Hz targets, its set-up, at its own levels (each
+    """The paper's claims of Sec. 4 on the logger's targets, its set-up, at its own levels (each
     requiring the conditions of the pockets it covers, the cutter locations and the logger's
     rate); the same accuracy bars on the 1 kHz targets and CAD/CAM's underestimate as ours.
 
     Parameters
     ----------
     feeds : ndarray, shape (n_seeds, n_models, N, 3)
-        :func:`seed_feeds` on the 5 Hz targets.
+        :func:`seed_feeds` on the logger's targets.
     runs : list of PocketRun
         Pockets 1 to 8, in order.
     sources : pandas.DataFrame
@@ -224,12 +228,12 @@ def claims(
         per set of seeds (the bootstrap draws the same sets for every claim)."""
         key = tuple(sorted(int(i) for i in rows[:, 0]))
         if key not in cache:
-            cache[key] = outcome(feeds[list(key)].mean(axis=0), runs)
+            cache[key] = outcome(feeds[list(key)], runs)
         return cache[key]
 
     index = np.arange(len(feeds))[:, None]  # the bootstrap resamples seeds by their index
-    ensemble = outcome(feeds.mean(axis=0), runs)
-    singles = [outcome(f, runs) for f in feeds]
+    ensemble = outcome(feeds, runs)
+    singles = [outcome(feeds[[s]], runs) for s in range(len(feeds))]
     out = []
     for cid, text, op, bar, value, pockets in _specs():
         claim = Claim(cid, f"Sun et al. 2022, {text}", value(ensemble), op, bar,
