@@ -9,8 +9,8 @@ and encoder noise to a kernel's command positions (Chien et al. 2023, "machine B
 Sun et al. (2022, Sec. 4.1) read the actual axis feeds of a Siemens 840D with a slow logger: 901
 samples against 5383 cutter locations, about 2.9 per second. :func:`controller_samples` samples
 a kernel's Motion the same way (a nominal rate with a seeded timing jitter), and
-:func:`nearest_sample` pairs each cutter location with the measured sample nearest to it, the paper's approximation of the feed
-"at" a cutter location.
+:func:`nearest_sample` pairs each cutter location with the measured sample nearest to it, the
+paper's approximation of the feed "at" a cutter location.
 """
 
 from __future__ import annotations
