@@ -4,7 +4,7 @@ sets.
 
 Targets: the ISO 10791-7-style test piece (:mod:`nctwin.programs.iso10791`, 405 blocks and
 about 7.5 minutes of motion) in under 2 s; the 3D finishing program
-(:mod:`nctwin.programs.finishing3d`, seed 0, 22,738 blocks, about 5.5 minutes) in under 5 s.
+(:mod:`nctwin.programs.finishing3d`, seed 0, 22,497 blocks, about 9.3 minutes) in under 5 s.
 The time is end to end (``simulate`` on a parsed program: feeds, interpolated points, the period
 loop, the Motion); shortest of 3 runs after one warm-up that also loads the compiled loop. The
 cycle times are records without a target, for the chapter.

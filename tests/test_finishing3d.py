@@ -34,16 +34,43 @@ def test_structure_of_the_passes():
     tp = finishing3d(1, SMALL)
     passes = 5  # y = 0, 1, 2, 3, 4
     counts = tp.kind_counts()
-    assert counts["arc_cw"] == 2 * passes and counts["arc_ccw"] == 0
-    assert counts["rapid"] == 3 * passes + 2
+    # zigzag: G2 leads on the passes along +X (3), G3 on those back (2)
+    assert counts["arc_cw"] == 2 * 3 and counts["arc_ccw"] == 2 * 2
+    # the safe height, across and down to the first lead-in; up and home at the end
+    assert counts["rapid"] == 5
     assert counts["dwell"] == 0
     assert (tp.plane[tp.is_arc] == Plane.ZX).all()
-    # each pass at its own Y; the cutting blocks of a pass do not move in Y
+    # each pass at its own Y; only the 4 links across move in Y
     cut = tp.kind != MotionKind.RAPID
-    assert (tp.start_mm[cut, 1] == tp.end_mm[cut, 1]).all()
+    moves_y = cut & (tp.start_mm[:, 1] != tp.end_mm[:, 1])
+    assert moves_y.sum() == passes - 1
+    np.testing.assert_allclose(tp.end_mm[moves_y, 1] - tp.start_mm[moves_y, 1], 1.0)
     np.testing.assert_array_equal(np.unique(tp.end_mm[cut, 1]), np.arange(passes, dtype=float))
-    # feeds: the passes and arcs at F2500, the descents at F1000 (mm/min)
-    np.testing.assert_allclose(np.unique(tp.feed_mm_s[cut]), [1000 / 60, 6000 / 60])
+    # the leads start beyond X = 0 on passes along +X and beyond X = width on those back
+    lead_in = np.flatnonzero(tp.is_arc)[::2]
+    assert (tp.start_mm[lead_in[::2], 0] < 0).all()
+    assert (tp.start_mm[lead_in[1::2], 0] > SMALL.width_mm).all()
+    # feeds: LHchips4's F1300, F800 on chords descending more steeply than 45 degrees
+    feeds = tp.feed_mm_s[cut] * 60
+    assert set(np.unique(np.round(feeds))) <= {800.0, 1300.0}
+    d = tp.end_mm[cut] - tp.start_mm[cut]
+    steep = (tp.kind[cut] == MotionKind.LINEAR) & (-d[:, 2] > np.abs(d[:, 0])) & (d[:, 0] != 0)
+    np.testing.assert_allclose(feeds[steep], 800.0)
+    np.testing.assert_allclose(feeds[~steep & (d[:, 0] != 0)], 1300.0)
+
+
+def test_steep_chords_take_the_steep_feed():
+    # a steep angle of 1 degree makes most descending chords steep: F written where it changes
+    p = FinishingParams(width_mm=30.0, length_mm=2.0, stepover_mm=1.0, steep_angle_deg=1.0)
+    text = finishing3d_program(1, p)
+    tp = parse(text)
+    d = tp.end_mm - tp.start_mm
+    chord = (tp.kind == MotionKind.LINEAR) & (d[:, 0] != 0)
+    steep = chord & (-d[:, 2] > math.tan(math.radians(1.0)) * np.abs(d[:, 0]))
+    assert steep.sum() > 10
+    np.testing.assert_allclose(tp.feed_mm_s[steep] * 60, 800.0)
+    np.testing.assert_allclose(tp.feed_mm_s[chord & ~steep] * 60, 1300.0)
+    assert text.count(" F") < chord.sum()  # modal, not on every block
 
 
 def test_lead_arcs_are_tangent_and_vertical_at_their_free_ends():
@@ -66,11 +93,14 @@ def test_chords_stay_within_the_cam_tolerance():
     text = finishing3d_program(5, p)
     tp = parse(text)
     surf = f3._Surface(np.random.default_rng(5), p)
+    # the chords, not the links across (which move in Y); passes 2 and 4 run back along -X
     chords = (tp.kind == MotionKind.LINEAR) & (tp.end_mm[:, 0] != tp.start_mm[:, 0])
-    for y in (0.0, 2.0, 4.0):
-        mine = chords & (tp.end_mm[:, 1] == y)
-        xs = np.concatenate([tp.start_mm[mine, 0][:1], tp.end_mm[mine, 0]])
-        zs = np.concatenate([tp.start_mm[mine, 2][:1], tp.end_mm[mine, 2]])
+    chords &= tp.end_mm[:, 1] == tp.start_mm[:, 1]
+    for y in (0.0, 1.0, 2.0, 4.0):
+        mine = np.flatnonzero(chords & (tp.end_mm[:, 1] == y))
+        pts = np.concatenate([tp.start_mm[mine[:1]], tp.end_mm[mine]])
+        pts = pts[np.argsort(pts[:, 0])]
+        xs, zs = pts[:, 0], pts[:, 2]
         fine = np.linspace(xs[0], xs[-1], 20001)
         true = surf.tip(fine, np.full(len(fine), y), p.tool_radius_mm)
         # vertical distance bounds the normal one; coordinates are rounded to 0.5 um
@@ -102,17 +132,42 @@ def test_the_ball_touches_the_surface_and_never_cuts_into_it():
 
 def test_default_program_matches_its_documented_statistics():
     stats = program_statistics(finishing3d_program(0))
-    assert stats["lines"] == 22867
-    assert stats["blocks"] == 22738
-    assert (stats["g0"], stats["g1"], stats["g2"], stats["g3"]) == (365, 22131, 242, 0)
-    assert stats["chords"] == 22010
-    assert stats["cut_length_mm"] == pytest.approx(10950, abs=1)
-    assert stats["rapid_length_mm"] == pytest.approx(13491, abs=1)
+    assert stats["lines"] == 22626
+    assert stats["blocks"] == 22497
+    assert (stats["g0"], stats["g1"], stats["g2"], stats["g3"]) == (5, 22250, 122, 120)
+    assert stats["chords"] == 22126
+    assert stats["cut_length_mm"] == pytest.approx(12042, abs=1)
+    assert stats["arc_length_mm"] == pytest.approx(1908, abs=1)
+    assert stats["rapid_length_mm"] == pytest.approx(159, abs=1)
     assert stats["chord_min_mm"] == pytest.approx(0.085, abs=1e-3)
-    assert stats["chord_median_mm"] == pytest.approx(0.425, abs=1e-3)
+    assert stats["chord_median_mm"] == pytest.approx(0.426, abs=1e-3)
     assert stats["chord_max_mm"] <= 1.001 + 1e-9
-    assert stats["chord_share_below_0_5mm"] == pytest.approx(0.629, abs=1e-3)
+    assert stats["chord_share_below_0_5mm"] == pytest.approx(0.626, abs=1e-3)
+    assert stats["feed_main_mm_min"] == 1300 and stats["feed_min_mm_min"] == 800
+    assert stats["arc_radius_median_mm"] == pytest.approx(5.0, abs=1e-3)
     assert f"{stats['lines']:,.0f}" in f3.__doc__
+
+
+def test_leads_feeds_and_rapids_are_the_real_programs():
+    """LHchips4's F words are written F999...; restored, its arcs are all R 5 and it cuts most
+    of its length at F1300; the bear has no arcs, one feed and 7 rapids; ours: R 5 leads,
+    F1300, fewer rapids than either (no pass is far from the one before)."""
+    lh = program_statistics(f3.real_cam_text(PUBLIC / "LHchips4.ngc"))
+    bear = program_statistics(f3.real_cam_text(PUBLIC / "camotics_bear.nc"))
+    ours = program_statistics(finishing3d_program(0))
+    np.testing.assert_allclose([lh["arc_radius_min_mm"], lh["arc_radius_max_mm"]], 5.0, atol=1e-3)
+    assert lh["feed_main_mm_min"] == 1300.0 and lh["feed_main_share"] > 0.75
+    assert (lh["feed_min_mm_min"], lh["feed_max_mm_min"]) == (750.0, 5000.0)
+    assert lh["g0"] == 71 and bear["g0"] == 7
+    assert math.isnan(bear["arc_radius_median_mm"]) and bear["feed_main_mm_min"] == 6000.0
+    assert ours["arc_radius_median_mm"] == pytest.approx(lh["arc_radius_median_mm"], abs=1e-3)
+    assert ours["feed_main_mm_min"] == lh["feed_main_mm_min"]
+    assert ours["g0"] <= min(lh["g0"], bear["g0"])
+    # the restoration only touches a text that holds the post-processor's mark
+    assert (
+        f3.real_cam_text(PUBLIC / "camotics_bear.nc") == (PUBLIC / "camotics_bear.nc").read_text()
+    )
+    assert "F999" not in f3.real_cam_text(PUBLIC / "LHchips4.ngc")
 
 
 def test_chords_are_as_short_as_real_cam_finishing_output():
@@ -127,7 +182,7 @@ def test_chords_are_as_short_as_real_cam_finishing_output():
     assert lo <= ours["chord_median_mm"] <= hi
     share = [r["chord_share_below_0_5mm"] for r in real]
     assert min(share) - 0.05 <= ours["chord_share_below_0_5mm"] <= max(share) + 0.05
-    old = FinishingParams(tolerance_mm=0.01, max_segment_mm=2.0, feed_mm_min=2500.0)
+    old = FinishingParams(tolerance_mm=0.01, max_segment_mm=2.0)
     coarse = program_statistics(finishing3d_program(0, old))
     assert coarse["chord_median_mm"] > 2 * hi
 
@@ -146,6 +201,7 @@ def test_write_and_parse(tmp_path):
         ({"tolerance_mm": -0.01}, r"tolerance_mm = -0.01 is out of range"),
         ({"bumps": -1}, r"bumps = -1 is out of range: allowed integers >= 0"),
         ({"max_segment_mm": 0.005}, r"max_segment_mm = 0.005 is out of range: allowed >= 10"),
+        ({"steep_angle_deg": 91.0}, r"steep_angle_deg = 91.0 is out of range: allowed \(0, 90\]"),
     ],
 )
 def test_params_are_checked(changes, message):

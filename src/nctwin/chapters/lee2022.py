@@ -47,7 +47,7 @@ from ..kernel.fanuc import FanucRun
 from ..machine import Machine, load_profile
 from ..methods.lee2022 import check_program
 from ..paths import data_dir
-from ..programs.finishing3d import finishing3d_program, program_statistics
+from ..programs.finishing3d import finishing3d_program, program_statistics, real_cam_text
 from ..programs.iso10791 import test_piece_program
 from ..recordings import RecordedProgram, public_program_text
 from ..report.tables import Claim, accuracy_pct, error_pct, load_paper_table
@@ -213,12 +213,14 @@ def program_statistics_table(texts: dict[str, str]) -> pd.DataFrame:
     pandas.DataFrame
         One row per program (ours, then :data:`REAL_CAM_PROGRAMS`): ``program``, ``kind``
         (``"chapter"`` or ``"real CAM output"``) and the columns of
-        :func:`nctwin.programs.finishing3d.program_statistics`.
+        :func:`nctwin.programs.finishing3d.program_statistics` (the real programs read with
+        :func:`~nctwin.programs.finishing3d.real_cam_text`, which restores ``LHchips4.ngc``'s
+        feed words).
     """
     public = data_dir() / "programs" / "public"
     rows = [{"program": n, "kind": "chapter", **program_statistics(t)} for n, t in texts.items()]
     rows += [
-        {"program": n, "kind": "real CAM output", **program_statistics((public / n).read_text())}
+        {"program": n, "kind": "real CAM output", **program_statistics(real_cam_text(public / n))}
         for n in REAL_CAM_PROGRAMS
     ]
     return pd.DataFrame(rows)

@@ -1,9 +1,9 @@
 r"""A 3D ball-end finishing program over a smooth free-form surface, written as CAM writes it.
 
 The ISO 10791-7-style test piece (:mod:`nctwin.programs.iso10791`) is long lines, a few arcs and
-a bore of 72 chords. This program is the other kind: a one-way raster of a ball-end mill over a
+a bore of 72 chords. This program is the other kind: a zigzag raster of a ball-end mill over a
 free-form surface, thousands of short ``G1`` chords at a CAM tolerance, a tangent lead-in and
-lead-out arc in the ZX plane (``G18 G2``) on every pass and rapids between the passes. It is
+lead-out arc in the ZX plane (``G18``) on every pass and short links between the passes. It is
 where block overlap, the block-processing time and the arc-radius clamp of a control matter
 most.
 
@@ -15,64 +15,84 @@ The surface
     heights are then scaled down, if need be, so that no hollow is tighter than 1.25 tool
     radii (the tool must fit: a ball of radius r cannot finish a hollow of radius < r).
 The tool path
-    The ball's tip (the programmed point of a ball-end mill) on passes along +X at
-    ``y = 0, stepover, 2 stepover, ...``. Each point is an exact drop-cutter position for the
-    smooth surface: the ball touches the surface at the point whose normal passes through the
-    ball's centre, found by Newton's method. Chords are placed as a CAM system places
-    them: their length is :math:`\min(L_{max}, \sqrt{8 \rho \delta})` for the path's local
-    radius of curvature :math:`\rho` (the largest curvature within 1 mm) and the tolerance
-    :math:`\delta`, so that no chord leaves the path by more than :math:`\delta`; coordinates
-    are written with 3 decimals (Fanuc IS-B).
+    The ball's tip (the programmed point of a ball-end mill) on passes along X (+X and back, in
+    turn) at ``y = 0, stepover, 2 stepover, ...``. Each point is an exact drop-cutter position for
+    the smooth surface: the ball touches the surface at the point whose normal passes through the
+    ball's centre, found by Newton's method. Chords are placed as a CAM system places them: their
+    length is :math:`\min(L_{max}, \sqrt{8 \rho \delta})` for the path's local radius of curvature
+    :math:`\rho` (the largest curvature within 1 mm) and the tolerance :math:`\delta`, so that no
+    chord leaves the path by more than :math:`\delta`; coordinates are written with 3 decimals
+    (Fanuc IS-B).
 The program
-    Fanuc style: F in mm/min, ``G18`` for the lead arcs, one line per block. Per pass: ``G0``
-    across at the safe height, ``G0`` down to 1 mm above the lead-in, ``G1`` down at the
-    approach feed, a quarter-ish ``G2`` lead-in of ``lead_radius_mm`` that starts straight down
-    and ends tangent to the pass, the chords at ``feed_mm_min``, a ``G2`` lead-out that ends
-    straight up, ``G0`` up to the safe height. Defaults: 80 mm x 60 mm, ball radius 3 mm,
-    step-over 0.5 mm, chordal tolerance 0.001 mm, chords up to 1 mm, F6000 (approach F1000),
-    lead radius 2 mm, 14 bumps.
+    Fanuc style: F in mm/min (written when it changes), ``G18`` for the lead arcs, one line per
+    block, a zigzag raster as both real programs below cut it. The first pass is reached by
+    ``G0`` across at the safe height and ``G0`` down to the start of its lead-in; every pass is
+    a quarter-ish lead-in arc of ``lead_radius_mm`` that starts straight down and ends tangent
+    to the pass, the chords, and a lead-out arc that ends straight up (``G2`` on the passes
+    along +X, ``G3`` on those back); the next pass is linked at the finishing feed, a ``G1`` up
+    or down to its lead-in's start and a ``G1`` across by the step-over. Chords that descend
+    more steeply than ``steep_angle_deg`` run at ``steep_feed_mm_min``, all else at
+    ``feed_mm_min``. Defaults: 80 mm x 60 mm, ball radius 3 mm, step-over 0.5 mm, chordal
+    tolerance 0.001 mm, chords up to 1 mm, F1300 (F800 on chords steeper than 45 degrees down),
+    lead radius 5 mm, 14 bumps.
 
 Why these defaults
 ------------------
-The chord lengths are what a control's block processing sees, so they are fixed from real CAM
-finishing output, the two 3D ball-end finishing programs shipped in ``data/programs/public/``
-(CAM output; chords as :func:`program_statistics` counts them):
+They are taken from the two real CAM 3D ball-end finishing programs shipped in
+``data/programs/public/`` (``LHchips4.ngc``, read with its feed words restored by
+:func:`real_cam_text`, and ``camotics_bear.nc``), as :func:`program_statistics` measures them:
 
-=====================  ==========  ===========  =========  ============  =====
-program                chords      p5 (mm)      median     < 0.5 mm      F
-=====================  ==========  ===========  =========  ============  =====
-``LHchips4.ngc``       6,911       0.167        0.294      62 %          n/a
-``camotics_bear.nc``   14,831      0.167        0.530      47 %          6000
-this program, seed 0   22,010      0.168        0.425      63 %          6000
-=====================  ==========  ===========  =========  ============  =====
+=====================  ======  =====  =========  ========  ==========  ==============  ======
+program                chords  p5     median     < 0.5 mm  lead arcs   cutting feed    G0
+=====================  ======  =====  =========  ========  ==========  ==============  ======
+``LHchips4.ngc``       6,911   0.167  0.294      62 %      225, R 5    F1300 (77 %)    71
+``camotics_bear.nc``   14,831  0.167  0.530      47 %      none        F6000 (100 %)   7
+this program, seed 0   22,126  0.168  0.426      63 %      242, R 5    F1300 (99.8 %)  5
+=====================  ======  =====  =========  ========  ==========  ==============  ======
 
-A chordal tolerance of 0.01 mm gives chords of at least :math:`\sqrt{8 r \delta}` = 0.49 mm
-over every convex region of this surface (the tip path's radius there is at least the ball's
-radius r), median 1.39 mm, only 4 % below 0.5 mm: far longer than the real programs. The real
-programs' short chords come from a finer chord tolerance (CAM splits the total tolerance
-between the chords and the surface fit) and from finer model facets; 0.001 mm with chords of at
-most 1 mm reproduces their distribution. The feed is the real relief program's (F6000; the
-other's F words are corrupted). :func:`program_statistics` recomputes the table's last row;
-``nctwin.chapters.lee2022.program_statistics_table`` writes all three rows to the chapter's
-results.
+(chord lengths in mm; the feed that covers the most cutting length and its share.)
+
+*Chords.* The chord lengths are what a control's block processing sees. A chordal tolerance of
+0.01 mm gives chords of at least :math:`\sqrt{8 r \delta}` = 0.49 mm over every convex region
+of this surface (the tip path's radius there is at least the ball's radius r), median 1.39 mm,
+only 4 % below 0.5 mm: far longer than the real programs. The real programs' short chords come
+from a finer chord tolerance (CAM splits the total tolerance between the chords and the surface
+fit) and from finer model facets; 0.001 mm with chords of at most 1 mm reproduces their
+distribution.
+
+*Leads, feeds and links.* Only ``LHchips4.ngc`` has lead arcs: every one of its 225 arcs has a
+radius of 5 mm, and all but the 4 of its final contour are quarter-ish leads in the plane of their
+pass, ``G2``/``G3`` as the pass runs, so the lead radius is 5 mm. Its passes run at F1300 and drop
+to F800 on chords that descend more steeply than 45 degrees (every F800 chord descends at 41.6
+degrees or more, no F1300 chord at more than 45); its few other feeds are a final contour at F1000
+and single moves. The feed, lead and link rules are this program's, as a consistent set: the arc
+clamp sees :math:`F^2 / R`, so an R 5 lead belongs with the feed it was cut at. ``camotics_bear.nc``
+cuts everything at F6000 (the chapter also runs this program at that feed:
+:mod:`nctwin.chapters.lee2022_sweeps`). Neither program retracts between adjacent passes:
+``LHchips4.ngc`` links most of its 116 passes with two ``G1`` moves (up or down, then across) and
+retracts (three ``G0``) only to jump to a pass that is not the next one, ``camotics_bear.nc`` steps
+over with ``G1``; this program's passes are all adjacent, so its only rapids are the approach and
+the return. :func:`program_statistics` recomputes the table's rows;
+``nctwin.chapters.lee2022.program_statistics_table`` writes all three rows to the chapter's results.
 
 Statistics
 ----------
 With the default :class:`FinishingParams` and ``seed=0``:
 
 ===============================  ==============================================
-lines                            22,867
-blocks                           22,738: 22,131 G1, 242 G2, 365 G0
+lines                            22,626
+blocks                           22,497: 22,250 G1, 122 G2, 120 G3, 5 G0
 passes                           121 (step-over 0.5 mm, 80 mm long each)
-G1 chords (G1 that move in X)    22,010 (the other 121 G1 are the descents)
-cutting path length (G1, G2)     10,950 mm, of which lead arcs 763 mm
-rapid path length                13,491 mm
-chord length (mm)                min 0.085, p5 0.168, median 0.425,
-                                 mean 0.457, p95 0.870, max 1.001
-chords shorter than 0.5 mm       62.9 %
+G1 chords (G1 that move in X)    22,126 (with the links across that move in X;
+                                 the other 124 G1 do not)
+cutting path length (G1, G2, G3) 12,042 mm, of which lead arcs 1,908 mm
+rapid path length                159 mm
+chord length (mm)                min 0.085, p5 0.168, median 0.426,
+                                 mean 0.458, p95 0.869, max 1.001
+chords shorter than 0.5 mm       62.6 %
 ===============================  ==============================================
 
-(``seed=1``: 19,813 blocks, 19,085 chords, median 0.485 mm, min 0.095 mm.) To recompute:
+(``seed=1``: 19,572 blocks, 19,204 chords, median 0.487 mm, min 0.095 mm.) To recompute:
 ``program_statistics(finishing3d_program(seed=0))``, which parses the text with
 :func:`nctwin.gcode.parse` and reads ``Toolpath.lengths_mm``: the chords are the ``G1`` blocks
 whose X moves, the percentiles ``numpy.percentile`` of their lengths.
@@ -94,6 +114,7 @@ __all__ = [
     "finishing3d",
     "finishing3d_program",
     "program_statistics",
+    "real_cam_text",
     "write_finishing3d",
 ]
 
@@ -117,9 +138,11 @@ class FinishingParams:
     max_segment_mm : float
         Longest chord CAM writes.
     feed_mm_min : float
-        Finishing feed of the passes and lead arcs.
-    approach_feed_mm_min : float
-        Feed of the descent to the lead-in arc.
+        Finishing feed of the passes, lead arcs and links.
+    steep_feed_mm_min : float
+        Feed of the chords that descend more steeply than ``steep_angle_deg``.
+    steep_angle_deg : float
+        Descent angle (from the horizontal) beyond which a chord takes ``steep_feed_mm_min``.
     lead_radius_mm : float
         Radius of the lead-in and lead-out arcs.
     bumps : int
@@ -132,9 +155,10 @@ class FinishingParams:
     tool_radius_mm: float = 3.0
     tolerance_mm: float = 0.001
     max_segment_mm: float = 1.0
-    feed_mm_min: float = 6000.0
-    approach_feed_mm_min: float = 1000.0
-    lead_radius_mm: float = 2.0
+    feed_mm_min: float = 1300.0
+    steep_feed_mm_min: float = 800.0
+    steep_angle_deg: float = 45.0
+    lead_radius_mm: float = 5.0
     bumps: int = 14
 
     def __post_init__(self) -> None:
@@ -146,7 +170,8 @@ class FinishingParams:
             ("tolerance_mm", 1.0),
             ("max_segment_mm", 100.0),
             ("feed_mm_min", 100000.0),
-            ("approach_feed_mm_min", 100000.0),
+            ("steep_feed_mm_min", 100000.0),
+            ("steep_angle_deg", 90.0),
             ("lead_radius_mm", 100.0),
         ):
             v = getattr(self, name)
@@ -264,14 +289,26 @@ def _num(v: float) -> str:
     return "0" if s in ("-0", "") else s
 
 
-def _lead(point: np.ndarray, slope: float, r: float, entering: bool) -> tuple[np.ndarray, ...]:
+def _lead(
+    point: np.ndarray, slope: float, r: float, entering: bool, direction: float
+) -> tuple[np.ndarray, ...]:
     """Lead arc in the XZ plane of radius ``r`` tangent to the pass at ``point`` (x, z) where the
-    pass has slope ``dz/dx``: into the pass from straight down (``entering``), or out of it to
-    straight up. Returns the arc's start, end and centre, each shape (2,) as (x, z)."""
-    t = np.array([1.0, slope]) / math.hypot(1.0, slope)
-    centre = point + r * np.array([-t[1], t[0]])  # on the left of the travel, above the pass
-    outside = centre + np.array([-r, 0.0]) if entering else centre + np.array([r, 0.0])
+    pass, travelled along ``direction`` X (+1 or -1), has slope ``dz/dx``: into the pass from
+    straight down (``entering``), or out of it to straight up. Returns the arc's start, end and
+    centre, each shape (2,) as (x, z)."""
+    centre = point + r * np.array([-slope, 1.0]) / math.hypot(1.0, slope)  # above the pass
+    outside = centre + np.array([-direction * r, 0.0] if entering else [direction * r, 0.0])
     return (outside, point, centre) if entering else (point, outside, centre)
+
+
+def _arc(start: np.ndarray, end: np.ndarray, centre: np.ndarray) -> str:
+    """The ``G2``/``G3`` block of a lead arc (start, end and centre as (x, z), each (2,)) in the
+    ZX plane: clockwise seen from +Y with the plane's axes in the order (Z, X)."""
+    a, b = start - centre, end - centre
+    cross = a[1] * b[0] - a[0] * b[1]  # (z, x) components: z_a x_b - x_a z_b
+    word = "G03" if cross > 0 else "G02"
+    i, k = centre - start
+    return f"{word} X{_num(end[0])} Z{_num(end[1])} I{_num(i)} K{_num(k)}"
 
 
 def finishing3d_program(seed: int = 0, params: FinishingParams | None = None) -> str:
@@ -301,7 +338,7 @@ def finishing3d_program(seed: int = 0, params: FinishingParams | None = None) ->
     safe_z = math.ceil(dense.max() + p.lead_radius_mm + 5.0)
     head = [
         "%",
-        "(3D BALL-END FINISHING, ONE-WAY RASTER ALONG X, WRITTEN BY NCTWIN.PROGRAMS.FINISHING3D)",
+        "(3D BALL-END FINISHING, ZIGZAG RASTER ALONG X, WRITTEN BY NCTWIN.PROGRAMS.FINISHING3D)",
         f"(SEED={seed}, " + ", ".join(f"{k}={v}" for k, v in asdict(p).items()) + ")",
         "G21 G90 G18 G40 G49 G80 G94",
         "M03 S12000",
@@ -315,26 +352,38 @@ def finishing3d_program(seed: int = 0, params: FinishingParams | None = None) ->
     dx = 1e-3
     ex = np.tile([0.0, dx, p.width_mm - dx, p.width_mm], n_pass)
     edge = surf.tip(ex, np.repeat(ys, 4), r).reshape(n_pass, 4)
+    steep = math.tan(math.radians(p.steep_angle_deg))
     body: list[str] = []
-    feed, approach = _num(p.feed_mm_min), _num(p.approach_feed_mm_min)
+    modal: list[str] = [""]  # the F word in force
+
+    def feed(value: float) -> str:
+        word = f" F{_num(value)}"
+        if word == modal[0]:
+            return ""
+        modal[0] = word
+        return word
+
     for k, y in enumerate(ys):
-        cx, cz = chord_x[k], chord_z[k]
-        slope_in, slope_out = (edge[k, 1] - edge[k, 0]) / dx, (edge[k, 3] - edge[k, 2]) / dx
-        a0, a1, ac = _lead(np.array([cx[0], cz[0]]), slope_in, p.lead_radius_mm, True)
-        b0, b1, bc = _lead(np.array([cx[-1], cz[-1]]), slope_out, p.lead_radius_mm, False)
+        d = 1.0 if k % 2 == 0 else -1.0  # zigzag: even passes along +X, odd ones back
+        cx, cz = (chord_x[k], chord_z[k]) if d > 0 else (chord_x[k][::-1], chord_z[k][::-1])
+        s0, s1 = (edge[k, 1] - edge[k, 0]) / dx, (edge[k, 3] - edge[k, 2]) / dx
+        slope_in, slope_out = (s0, s1) if d > 0 else (s1, s0)
+        a0, a1, ac = _lead(np.array([cx[0], cz[0]]), slope_in, p.lead_radius_mm, True, d)
+        b0, b1, bc = _lead(np.array([cx[-1], cz[-1]]), slope_out, p.lead_radius_mm, False, d)
         body.append(f"(PASS {k + 1} OF {n_pass}, Y{_num(y)})")
-        body.append(f"G00 X{_num(a0[0])} Y{_num(y)}")
-        body.append(f"G00 Z{_num(a0[1] + 1.0)}")
-        body.append(f"G01 Z{_num(a0[1])} F{approach}")
-        body.append(
-            f"G02 X{_num(a1[0])} Z{_num(a1[1])} I{_num(ac[0] - a0[0])} K{_num(ac[1] - a0[1])} "
-            f"F{feed}"
-        )
-        body += [f"G01 X{_num(x)} Z{_num(z)}" for x, z in zip(cx[1:], cz[1:], strict=True)]
-        body.append(
-            f"G02 X{_num(b1[0])} Z{_num(b1[1])} I{_num(bc[0] - b0[0])} K{_num(bc[1] - b0[1])}"
-        )
-        body.append(f"G00 Z{_num(safe_z)}")
+        if k == 0:  # rapid to the lead-in's start, as the CAM programs do
+            body.append(f"G00 X{_num(a0[0])} Y{_num(y)}")
+            body.append(f"G00 Z{_num(a0[1])}")
+        else:  # link from the last lead-out at the finishing feed: down or up, then across
+            body.append(f"G01 Z{_num(a0[1])}" + feed(p.feed_mm_min))
+            body.append(f"G01 X{_num(a0[0])} Y{_num(y)}" + feed(p.feed_mm_min))
+        body.append(_arc(a0, a1, ac) + feed(p.feed_mm_min))
+        down = -np.diff(cz) > steep * np.abs(np.diff(cx))
+        for x, z, dn in zip(cx[1:], cz[1:], down, strict=True):
+            body.append(f"G01 X{_num(x)} Z{_num(z)}" + feed(p.steep_feed_mm_min if dn
+                                                               else p.feed_mm_min))  # fmt: skip
+        body.append(_arc(b0, b1, bc) + feed(p.feed_mm_min))
+    body.append(f"G00 Z{_num(safe_z)}")
     tail = ["G00 X0 Y0", "M05", "M30", "%"]
     return "\n".join(head + body + tail) + "\n"
 
@@ -356,8 +405,29 @@ def write_finishing3d(
     return target
 
 
+def real_cam_text(path: str | Path) -> str:
+    """The text of a real CAM program with its feed words restored.
+
+    ``LHchips4.ngc``'s post-processor wrote every letter F as ``F999``: its comments read
+    ``F999ile``, ``F999inished`` and ``ONLY F999INISH``, its feed words ``F9991300.0`` and
+    ``F999800.0``. Where a text holds ``F999ile``, every ``F999`` is put back to ``F``; any
+    other text is returned as read.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The program's file.
+
+    Returns
+    -------
+    str
+    """
+    text = Path(path).read_text()
+    return text.replace("F999", "F") if "F999ile" in text else text
+
+
 def program_statistics(text: str) -> dict[str, float]:
-    """Size of a program: lines, blocks, path lengths and the chord-length distribution.
+    """Size of a program: lines, blocks, path lengths, feeds, arc radii and the chord lengths.
 
     Parameters
     ----------
@@ -368,8 +438,12 @@ def program_statistics(text: str) -> dict[str, float]:
     -------
     dict of str to float
         ``lines``; ``blocks`` and ``g0``, ``g1``, ``g2``, ``g3`` blocks; ``cut_length_mm`` (G1,
-        G2, G3), ``arc_length_mm``, ``rapid_length_mm``; over the G1 blocks that move in X
-        (the chords, not the plunges): ``chords`` and their length ``chord_min_mm``,
+        G2, G3), ``arc_length_mm``, ``rapid_length_mm``; the cutting feeds (mm/min) over the
+        G1, G2, G3 blocks: ``feed_main_mm_min``, the feed that covers the most cutting length,
+        and ``feed_main_share``, the share it covers, ``feed_min_mm_min`` and
+        ``feed_max_mm_min``; the arcs' radii ``arc_radius_min_mm``, ``arc_radius_median_mm``,
+        ``arc_radius_max_mm`` (NaN without arcs); over the G1 blocks that move in X (the
+        chords, not the plunges): ``chords`` and their length ``chord_min_mm``,
         ``chord_p5_mm``, ``chord_median_mm``, ``chord_mean_mm``, ``chord_p95_mm``,
         ``chord_max_mm`` and ``chord_share_below_0_5mm``.
     """
@@ -380,6 +454,11 @@ def program_statistics(text: str) -> dict[str, float]:
     chords = lin & (np.abs(tp.end_mm[:, 0] - tp.start_mm[:, 0]) > 0)
     c = lengths[chords]
     q = np.percentile(c, [5, 50, 95]) if len(c) else np.full(3, np.nan)
+    cut = (tp.kind >= 1) & (tp.kind <= 3)
+    feeds, where = np.unique(np.round(60.0 * tp.feed_mm_s[cut], 3), return_inverse=True)
+    per_feed = np.bincount(where, weights=lengths[cut], minlength=len(feeds))
+    main = int(np.argmax(per_feed)) if len(feeds) else -1
+    radii = tp.radius_mm[tp.is_arc]
     return {
         "lines": float(text.count("\n")),
         "blocks": float(len(tp)),
@@ -387,9 +466,16 @@ def program_statistics(text: str) -> dict[str, float]:
         "g1": float(counts[MotionKind.LINEAR]),
         "g2": float(counts[MotionKind.ARC_CW]),
         "g3": float(counts[MotionKind.ARC_CCW]),
-        "cut_length_mm": float(lengths[(tp.kind >= 1) & (tp.kind <= 3)].sum()),
+        "cut_length_mm": float(lengths[cut].sum()),
         "arc_length_mm": float(lengths[tp.is_arc].sum()),
         "rapid_length_mm": float(lengths[tp.kind == MotionKind.RAPID].sum()),
+        "feed_main_mm_min": float(feeds[main]) if len(feeds) else math.nan,
+        "feed_main_share": float(per_feed[main] / per_feed.sum()) if len(feeds) else math.nan,
+        "feed_min_mm_min": float(feeds[0]) if len(feeds) else math.nan,
+        "feed_max_mm_min": float(feeds[-1]) if len(feeds) else math.nan,
+        "arc_radius_min_mm": float(radii.min()) if len(radii) else math.nan,
+        "arc_radius_median_mm": float(np.median(radii)) if len(radii) else math.nan,
+        "arc_radius_max_mm": float(radii.max()) if len(radii) else math.nan,
         "chords": float(len(c)),
         "chord_min_mm": float(c.min()) if len(c) else math.nan,
         "chord_p5_mm": float(q[0]),
