@@ -176,3 +176,12 @@ def test_nearest_sample_since_keeps_to_the_block():
     assert nearest_sample(rec, point, passage, since_s=np.array([0.5]))[0] == 1  # on the block
     assert nearest_sample(rec, point, passage, since_s=np.array([np.nan]))[0] == 2
     assert nearest_sample(rec, point, passage, since_s=np.array([0.95]))[0] == 2  # none: all
+
+
+def test_calibration_bands_are_the_chapters():
+    from nctwin.chapters import sun2022_claims
+    from nctwin.programs import thinwall_calibrate
+
+    assert thinwall_calibrate.CAM_TIME_TOL_PCT == sun2022_claims.CAM_TIME_TOL_PCT
+    assert thinwall_calibrate.CAM_POINTS == sun2022_claims.CAM_POINTS
+    assert thinwall_calibrate.CL_TOL_PCT == sun2022_claims.CL_TOL_PCT
