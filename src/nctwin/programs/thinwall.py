@@ -128,8 +128,10 @@ class PocketSpec:
 #: only: the length (the longer side; the regions' height on the two-region pocket 8) so that the
 #: CAD/CAM time is Table 3's, the trochoid radius so that the machine's time over CAD/CAM's gives
 #: Table 3's CAD/CAM error, and pocket 1's trochoid advance so that it has the paper's 5383 cutter
-#: locations. Pocket 3 has two depth levels: with three, the loops round its island alone take
-#: longer than its CAD/CAM time at the radius its error needs. The centres follow from the sizes.
+#: locations. Pockets 2 and 7 sit below the middle of their error band, where tighter loops stop
+#: adding error (the loops' share of the path shrinks with their radius). Pocket 3 has two depth
+#: levels: with three, the loops round its island alone take longer than its CAD/CAM time at the
+#: radius its error needs. The centres follow from the sizes.
 POCKETS = (
     PocketSpec(1, "rect", (84.0, 60.0), (127.4, 90.0), 0.0, 3500.0, 4, 1.91, 0.98),
     PocketSpec(2, "rounded", (224.0, 60.0), (106.5, 48.0), 12.0, 3000.0, 2, 0.49),
