@@ -96,6 +96,19 @@ def test_the_ensemble_averages_the_seeds_times(triangle_run):
     assert predict_time([c, d], triangle_run)[0] == pytest.approx(17.5)
 
 
+def test_time_by_block_length_splits_the_path(triangle_run):
+    from nctwin.chapters.sun2022 import time_by_block_length
+
+    # 30 and 40 mm lines are both long blocks; constant feeds (3, 4, 0) give 70 / 5 = 14 s
+    table = time_by_block_length({0: triangle_run}, [[_Constant(3.0), _Constant(4.0),
+                                                      _Constant(0.0)]])  # fmt: skip
+    long, short = table.iloc[0], table.iloc[1]
+    assert (long["blocks"], long["count"], short["count"]) == ("long", 2, 0)
+    assert long["length_share_pct"] == pytest.approx(100.0)
+    assert long["model_s"] == pytest.approx(14.0)
+    assert long["machine_s"] == pytest.approx(triangle_run.measured_s, rel=0.01)
+
+
 def test_models_are_table2():
     from nctwin.chapters.sun2022 import MODELS
     from nctwin.report.tables import load_paper_table

@@ -44,6 +44,7 @@ from .your_program import ProgramResult, block_feeds, domain_notes, program_time
 
 __all__ = [
     "IMPROVED_POCKETS",
+    "LONG_BLOCK_MM",
     "MODELS",
     "SEEDS",
     "TRAIN_CONFIG",
@@ -60,6 +61,7 @@ __all__ = [
     "run_pockets",
     "seed_table",
     "target_time",
+    "time_by_block_length",
     "train_ensembles",
     "training_table",
     "your_program",
@@ -205,8 +207,9 @@ def part_stats(
     runs: dict[int, PocketRun], paper3: pd.DataFrame, summary: pd.DataFrame
 ) -> pd.DataFrame:
     """The part beside the paper's: per pocket the cutter locations, records, rapids, path
-    length, CAD/CAM and measured times, and the paper's numbers where it gives them (Table 3;
-    cutter locations and records of pocket 1 only, Sec. 4.1).
+    length, the calibrated trochoid radius and advance, CAD/CAM and measured times, and the
+    paper's numbers where it gives them (Table 3; cutter locations and records of pocket 1
+    only, Sec. 4.1).
 
     Parameters
     ----------
@@ -218,6 +221,7 @@ def part_stats(
     """
     quantity = summary.set_index("quantity")["value"]
     paper = paper3.set_index("pocket")
+    spec = {p.number: p for p in POCKETS}
     rows = []
     for k, r in runs.items():
         rows.append({
@@ -227,6 +231,8 @@ def part_stats(
             "rapids": int((r.toolpath.kind == MotionKind.RAPID).sum()),
             "length_mm": r.toolpath.length_mm,
             "mean_cl_spacing_mm": r.toolpath.length_mm / len(r.toolpath),
+            "trochoid_radius_mm": spec[k].trochoid_radius_mm,
+            "trochoid_advance_mm": spec[k].trochoid_advance_mm,
             "cam_s": r.cam_s,
             "measured_s": r.measured_s,
             "paper_cutter_locations": quantity["pocket1_commanded_points"] if k == 1 else np.nan,
@@ -492,6 +498,52 @@ def error_sources(
                     t, _ = predict_time(ensembles[name, target], run)
                     row[f"{short}_{label}_err_pct"] = error_pct(t, run.measured_s, signed=True)
         rows.append(row)
+    return pd.DataFrame(rows)
+
+
+#: Blocks at least this long (mm) are the part's straight moves (one G1 line each), its links
+#: and most of its rapids; the chords of its curves and its plunges are shorter.
+LONG_BLOCK_MM = 10.0
+
+
+def time_by_block_length(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.DataFrame:
+    """Where eq. 10's time goes: per pocket, over its long blocks (at least
+    :data:`LONG_BLOCK_MM`: straight moves, links, most rapids) and over the others (chords of
+    curves, plunges), the machine's time and eq. 10's.
+
+    Parameters
+    ----------
+    runs : dict of PocketRun
+    members : list of [X, Y, Z network]
+        An ensemble (:func:`predict_time`), trained on the logger's targets.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Per pocket and ``blocks`` (``"long"``, ``"short"``): ``count``, ``length_share_pct``
+        (of the pocket's path), ``machine_s`` (between the junction points, 1 kHz), eq. 10's
+        time fed with the logger's targets (``logger_eq10_s``), with the 1 kHz block averages
+        (``khz_eq10_s``) and with the ensemble's feeds (``model_s``), all in s.
+    """
+    rows = []
+    for k, run in runs.items():
+        lengths = run.toolpath.lengths_mm
+        machine = np.diff(block_targets(run.motion, run.toolpath).junction_sample)
+        machine = machine * run.motion.period_s
+        _, feed = predict_time(members, run)
+        times = {
+            "machine_s": machine,
+            "logger_eq10_s": sun.block_times_s(run.measured_feed_mm_s, lengths,
+                                               run.commanded_mm_s),
+            "khz_eq10_s": sun.block_times_s(run.true_feed_mm_s, lengths, run.commanded_mm_s),
+            "model_s": lengths / feed,
+        }  # fmt: skip
+        for name, on in (("long", lengths >= LONG_BLOCK_MM), ("short", lengths < LONG_BLOCK_MM)):
+            rows.append({
+                "pocket": k, "blocks": name, "count": int(on.sum()),
+                "length_share_pct": 100 * lengths[on].sum() / lengths.sum(),
+                **{key: float(t[on].sum()) for key, t in times.items()},
+            })  # fmt: skip
     return pd.DataFrame(rows)
 
 
