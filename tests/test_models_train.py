@@ -123,19 +123,22 @@ def test_batch_of_windows_is_the_windows_stacked_by_hand(lengths, w, seed):
     batch_size=st.integers(1, 5),
     seed=st.integers(0, 2**16),
 )
-def test_epoch_rows_are_the_valid_rows_of_the_batches(lengths, w, batch_size, seed):
+def test_one_gather_for_many_batches_gives_each_batch_as_its_own_gather(
+    lengths, w, batch_size, seed
+):
+    """The epoch gathers many batches' windows at once; each slice is the batch gathered alone
+    (so a network trains bit for bit as with one gather per batch)."""
     rng = np.random.default_rng(seed)
     xs = [rng.normal(size=(n, 3)) for n in lengths]
-    programs = _Programs(xs, [x[:, :1] for x in xs])
+    ys = [np.where(rng.random((len(x), 1)) < 0.2, np.nan, x[:, :1]) for x in xs]
+    programs = _Programs(xs, ys)
     windows = _windows(lengths, w, rng)
     windows = windows[rng.permutation(len(windows))]
-    rows, bounds, counts = programs.epoch_rows(windows, batch_size)
-    assert bounds[0] == 0 and bounds[-1] == len(rows) and np.all(np.diff(bounds) > 0)
-    for b in range(len(bounds) - 1):  # by hand: batch b's windows, their valid rows in order
-        chunk = windows[b * batch_size : (b + 1) * batch_size]
-        assert counts[b] == len(chunk)
-        x, _, m = programs.batch(chunk, w)
-        np.testing.assert_array_equal(programs.x[rows[bounds[b] : bounds[b + 1]]], x[m[..., 0]])
+    together = programs.batch(windows, w)
+    for b in range(0, len(windows), batch_size):
+        alone = programs.batch(windows[b : b + batch_size], w)
+        for t, u in zip(together, alone, strict=True):
+            np.testing.assert_array_equal(t[b : b + batch_size].numpy(), u.numpy())
 
 
 def test_checkpoint_round_trip_and_cache_hit():

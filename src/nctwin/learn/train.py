@@ -22,22 +22,19 @@ Windows
 Determinism
     The initial weights, the window offsets and the batch order are drawn from generators seeded
     with ``seed``, and so are dropout masks (torch's global generator, seeded with ``seed``
-    inside :func:`torch.random.fork_rng`, so the caller's random state is untouched; the BP
-    network's written-out epoch draws from its own generator); :func:`fit` runs with
+    inside :func:`torch.random.fork_rng`, so the caller's random state is untouched);
+    :func:`fit` runs with
     ``torch.use_deterministic_algorithms(True)``, one torch intra-op thread
     (``torch.set_num_threads(1)``) and one BLAS thread (:func:`threadpoolctl.threadpool_limits`):
     summation order, hence rounding, depends on the thread count. It restores all three when it
     returns. The same data and configs give the same weights, bit for bit, on one machine.
 Steps
-    A step is autograd and a :mod:`torch.optim` optimiser, except for the BP network with SGD,
-    whose epoch is written out and compiled (:class:`~nctwin.learn.bp_sgd.BPEpoch`: the same
-    arithmetic, batch for batch, with the torch and Python bookkeeping of every step gone).
+    A step is autograd and a :mod:`torch.optim` optimiser, for every network.
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
     ``AVX512`` on such a CPU outside it: their rounding differs, so a network trained outside
-    ``make`` is never reused by a chapter run through it; the written-out epoch adds OpenBLAS's
-    kernels, :func:`~nctwin.learn.bp_sgd.blas_kernels`), written atomically (temporary file,
+    ``make`` is never reused by a chapter run through it), written atomically (temporary file,
     then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
     tensors and plain Python values only, never pickled objects.
 """
@@ -59,7 +56,6 @@ from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from ..cache import atomic_write, cache_path, content_key
-from .bp_sgd import BPEpoch, blas_kernels
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
@@ -328,26 +324,10 @@ class _Programs:
         y[~m] = 0.0
         return torch.from_numpy(x), torch.from_numpy(y), torch.from_numpy(m)
 
-    def epoch_rows(self, windows: np.ndarray, batch_size: int):
-        """The valid rows of ``windows`` (B, 3), in order, cut into batches of ``batch_size``
-        windows: ``rows`` (R,) int64, ``bounds`` (n_batches + 1,) int64 (batch ``b`` is
-        ``rows[bounds[b]:bounds[b + 1]]``) and each batch's window count (float64)."""
-        lengths = windows[:, 2]
-        offsets = np.concatenate([[0], np.cumsum(lengths)])  # row offset of each window
-        first = self.start[windows[:, 0]] + windows[:, 1]
-        rows = np.repeat(first - offsets[:-1], lengths) + np.arange(offsets[-1])
-        edges = np.append(np.arange(0, len(windows), batch_size), len(windows))
-        return rows.astype(np.int64), offsets[edges].astype(np.int64), np.diff(edges) * 1.0
-
 
 def _loss(pred: torch.Tensor, y: torch.Tensor, mask: torch.Tensor, kind: str) -> torch.Tensor:
     mse = ((pred - y) ** 2 * mask).sum() / mask.sum().clamp(min=1)
     return mse.sqrt() if kind == "rmse" else mse
-
-
-def _written_out(model_config: ModelConfig | BPConfig, cfg: TrainConfig) -> bool:
-    """Whether the epoch is :class:`~nctwin.learn.bp_sgd.BPEpoch` (the BP network with SGD)."""
-    return isinstance(model_config, BPConfig) and cfg.optimiser == "sgd"
 
 
 def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
@@ -359,6 +339,11 @@ def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
     return loss.detach()
 
 
+#: Batches whose windows :meth:`_AutogradRun.epoch` gathers at once (the gather is a fixed cost
+#: per call, as large as a small network's step).
+_BATCHES_PER_GATHER = 64
+
+
 class _AutogradRun:
     """Epochs by autograd and a :mod:`torch.optim` optimiser, validation by the torch model."""
 
@@ -368,7 +353,7 @@ class _AutogradRun:
         self.validation = validation.batch(_windows(validation.lengths, w, None), w)
         if cfg.optimiser == "sgd":
             self.optimiser = torch.optim.SGD(
-                model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum
+                model.parameters(), lr=cfg.learning_rate, momentum=cfg.momentum, foreach=True
             )
         else:
             self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
@@ -378,11 +363,14 @@ class _AutogradRun:
         weighted by their windows."""
         self.model.train()
         total, count, cfg = 0.0, 0, self.cfg
-        for b in range(0, len(windows), cfg.batch_size):
-            bx, by, bm = self.programs.batch(windows[b : b + cfg.batch_size], cfg.window_lines)
-            loss = _autograd_step(self.model, self.optimiser, cfg.loss, bx, by, bm)
-            total += float(loss) * len(bx)
-            count += len(bx)
+        chunk = cfg.batch_size * _BATCHES_PER_GATHER
+        for c in range(0, len(windows), chunk):  # one gather for many batches
+            xs, ys, ms = self.programs.batch(windows[c : c + chunk], cfg.window_lines)
+            for b in range(0, len(xs), cfg.batch_size):
+                bx, by, bm = (t[b : b + cfg.batch_size] for t in (xs, ys, ms))
+                loss = _autograd_step(self.model, self.optimiser, cfg.loss, bx, by, bm)
+                total += float(loss) * len(bx)
+                count += len(bx)
         self.model.eval()
         return total / count
 
@@ -396,28 +384,6 @@ class _AutogradRun:
 
     def load(self, state) -> None:
         self.model.load_state_dict(state)
-
-
-class _WrittenOutRun:
-    """The epochs and validation of :class:`~nctwin.learn.bp_sgd.BPEpoch`, batch for batch
-    those of :class:`_AutogradRun` (a batch: the valid rows of ``batch_size`` windows)."""
-
-    def __init__(self, model, cfg: TrainConfig, programs: _Programs, validation: _Programs):
-        self.cfg, self.programs, self.validation = cfg, programs, validation
-        self.bp = BPEpoch(model, cfg.learning_rate, cfg.momentum, cfg.loss, seed=cfg.seed)
-
-    def epoch(self, windows: np.ndarray) -> float:
-        rows = self.programs.epoch_rows(windows, self.cfg.batch_size)
-        return self.bp(self.programs.x, self.programs.y, *rows)
-
-    def validate(self) -> float:
-        return self.bp.loss(self.validation.x, self.validation.y)
-
-    def state(self) -> np.ndarray:
-        return self.bp.weights.copy()
-
-    def load(self, state: np.ndarray) -> None:
-        self.bp.load(state)
 
 
 def fit(
@@ -470,8 +436,6 @@ def fit(
            "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
-    if _written_out(model_config, train_config):  # written out, not autograd: other bits
-        key["step"], key["blas"] = "BPEpoch", blas_kernels()
     path = cache_path("models", name, content_key(key), ".pt")
     if cache and path.exists():
         return load_checkpoint(path)
@@ -489,7 +453,7 @@ def fit(
         # training repeats bit for bit and the caller's random state is left as it was
         with torch.random.fork_rng(devices=[]):
             torch.manual_seed(train_config.seed)
-            with one_thread(), threadpool_limits(1, user_api="blas"):  # BLAS: see bp_sgd
+            with one_thread(), threadpool_limits(1, user_api="blas"):
                 trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     finally:
         torch.use_deterministic_algorithms(deterministic)
@@ -521,8 +485,7 @@ def _train(
         model.load_state_dict(init.model.state_dict())
     programs = _Programs([zx[i] for i in train_idx], [zy[i] for i in train_idx])
     validation = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
-    run_class = _WrittenOutRun if _written_out(model_config, cfg) else _AutogradRun
-    run = run_class(model, cfg, programs, validation)
+    run = _AutogradRun(model, cfg, programs, validation)
     history: dict[str, list[float]] = {"train": [], "val": []}
     best, best_state, best_epoch, stale = math.inf, None, 0, 0
     # shown after 5 s only, so that short runs leave no text in executed notebooks; ``disable``
