@@ -136,3 +136,19 @@ def test_line_stats_by_hand():
     assert row.turn_over_90deg_pct == 25
     assert (row.long_tangent_both, row.long_tangent_both_pct) == (1, 50)
     assert (row.feed_min_mm_s, row.feed_max_mm_s) == (70, 80)
+
+
+def test_eq3_is_length_over_predicted_feed_and_an_ensembles_is_its_members_mean(small_ensemble):
+    from nctwin.methods.chien2023 import eq3_time_s
+
+    # by hand: 10 mm at 5 mm/s and 20 mm at 10 mm/s
+    assert eq3_time_s(np.array([5.0, 10.0]), np.array([10.0, 20.0])) == pytest.approx(4.0)
+    runs, members = small_ensemble
+    run = runs[0]
+    row = ch.eq3_rows({("p", 80.0, 0.3): run}, {"net": members}).iloc[0]
+    one = [eq3_time_s(ch.predict_run(m, run)[0], run.features[:, 1]) for m in members]
+    assert row.net_eq3_s == pytest.approx(np.mean(one))
+    assert row.net_eq3_err_pct == pytest.approx(abs(row.net_eq3_s / run.measured_s - 1) * 100)
+    assert row.net_err_pct == pytest.approx(
+        abs(ch.predict_run(members, run)[2] / run.measured_s - 1) * 100
+    )

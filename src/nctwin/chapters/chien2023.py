@@ -82,6 +82,7 @@ __all__ = [
     "convergence",
     "cutting_blocks",
     "cycle_time_rows",
+    "eq3_rows",
     "feed_rmse_mm_s",
     "fit_seeds",
     "line_stats",
@@ -488,6 +489,34 @@ def cycle_time_rows(
             row[f"{m}_err_pct"] = error_pct(t, run.measured_s)
         row["cam_s"] = run.cam_s
         row["cam_err_pct"] = error_pct(run.cam_s, run.measured_s)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def eq3_rows(
+    runs: dict[tuple[str, float, float], ProgramRun], models: dict[str, Trained | list[Trained]]
+) -> pd.DataFrame:
+    """Both routes from a network to the cycle time, per test program: the paper's eq. 3 over
+    the predicted average feeds with the nominal lengths
+    (:func:`nctwin.methods.chien2023.eq3_time_s`), and the chapter's, the predicted time ratio
+    (:func:`predict_run`). An ensemble's time is the mean of its members' times on both routes.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``toolpath, feed_mm_s, tol_mm, measured_s``, then per model ``<name>_eq3_s``,
+        ``<name>_eq3_err_pct`` and ``<name>_err_pct`` (the ratio route); errors unsigned, %.
+    """
+    rows = []
+    for (name, feed, tol), run in runs.items():
+        row = {"toolpath": name, "feed_mm_s": feed, "tol_mm": tol, "measured_s": run.measured_s}
+        for m, trained in models.items():
+            lengths = run.features[:, 1]
+            t = np.mean([chien.eq3_time_s(predict_run(one, run)[0], lengths)
+                         for one in _members(trained)])  # fmt: skip
+            row[f"{m}_eq3_s"] = float(t)
+            row[f"{m}_eq3_err_pct"] = error_pct(float(t), run.measured_s)
+            row[f"{m}_err_pct"] = error_pct(predict_run(trained, run)[2], run.measured_s)
         rows.append(row)
     return pd.DataFrame(rows)
 

@@ -28,6 +28,7 @@ __all__ = [
     "BILSTM_CONFIG",
     "FEATURES",
     "MIN_FEED_MM_S",
+    "eq3_time_s",
     "features",
     "predict",
 ]
@@ -114,3 +115,22 @@ def predict(output: np.ndarray, features: np.ndarray) -> tuple[np.ndarray, np.nd
     """
     feed = np.maximum(output[:, 0], MIN_FEED_MM_S)
     return feed, block_times_s(output[:, 1], features[:, 0], features[:, 1])
+
+
+def eq3_time_s(avg_feed_mm_s: np.ndarray, length_mm: np.ndarray) -> float:
+    r"""The paper's eq. 3 from the predicted average feeds, :math:`T = \sum_k l_k / \hat{\bar
+    f}_k`, with the nominal lengths :math:`l_k` (the blended :math:`\tilde l_k` are not known
+    before the program runs).
+
+    Parameters
+    ----------
+    avg_feed_mm_s, length_mm : ndarray, shape (N,)
+        :math:`\hat{\bar f}_k` (:func:`predict`, floored at :data:`MIN_FEED_MM_S`) and
+        :math:`l_k`.
+
+    Returns
+    -------
+    float
+        Cycle time (s).
+    """
+    return float(np.sum(length_mm / avg_feed_mm_s))
