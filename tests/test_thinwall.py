@@ -8,6 +8,12 @@ import numpy as np
 import pytest
 
 from nctwin import MotionKind, parse
+from nctwin.chapters.sun2022_part import (
+    calibrate,
+    calibrate_pocket,
+    pocket_conditions,
+    pocket_times,
+)
 from nctwin.kernel import fir
 from nctwin.machine import load_profile
 from nctwin.physics.measure import ControllerSamples, controller_samples, nearest_sample
@@ -19,12 +25,6 @@ from nctwin.programs.thinwall import (
     pocket_program,
     start_mm,
     thinwall_programs,
-)
-from nctwin.programs.thinwall_calibrate import (
-    calibrate,
-    calibrate_pocket,
-    pocket_conditions,
-    pocket_times,
 )
 from nctwin.report.tables import load_paper_table
 
@@ -194,12 +194,3 @@ def test_nearest_sample_since_keeps_to_the_block():
     assert nearest_sample(rec, point, passage, since_s=np.array([0.5]))[0] == 1  # on the block
     assert nearest_sample(rec, point, passage, since_s=np.array([np.nan]))[0] == 2
     assert nearest_sample(rec, point, passage, since_s=np.array([0.95]))[0] == 2  # none: all
-
-
-def test_calibration_bands_are_the_chapters():
-    from nctwin.chapters import sun2022_claims
-    from nctwin.programs import thinwall_calibrate
-
-    assert thinwall_calibrate.CAM_TIME_TOL_PCT == sun2022_claims.CAM_TIME_TOL_PCT
-    assert thinwall_calibrate.CAM_POINTS == sun2022_claims.CAM_POINTS
-    assert thinwall_calibrate.CL_TOL_PCT == sun2022_claims.CL_TOL_PCT

@@ -50,6 +50,7 @@ __all__ = [
     "TRAIN_CONFIG",
     "PocketRun",
     "error_sources",
+    "logger_variant",
     "machine_check",
     "part_stats",
     "predict_all_feeds",
@@ -397,6 +398,43 @@ def time_table(runs: dict[int, PocketRun], members: list[list[Trained]]) -> pd.D
             "cam_err_pct": error_pct(run.cam_s, run.measured_s, signed=True),
             "nn_s": nn_s, "nn_err_pct": error_pct(nn_s, run.measured_s, signed=True),
         })  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def logger_variant(
+    profile: Profile, rate_hz: float, *, seed: int = 0, seeds: tuple[int, ...] = SEEDS,
+    n_jobs: int = 2, **kwargs,
+) -> pd.DataFrame:  # fmt: skip
+    """Both models on a logger of another rate (a labelled variant of the paper's set-up): the
+    pockets run and recorded at ``rate_hz``, the networks trained on those records as the
+    chapter's are, and each model's ensemble error and the target bias per pocket.
+
+    Parameters
+    ----------
+    profile : Profile
+    rate_hz : float
+        The logger's records per second.
+    seed, seeds, n_jobs
+        As for :func:`run_pockets` and :func:`train_ensembles`.
+    **kwargs
+        To :func:`run_pocket` (``jitter_s``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``pocket, rate_hz, bias_err_pct, records_per_s, m1_err_pct, m2_err_pct``; signed, %.
+    """
+    runs = run_pockets(profile, seed=seed, n_jobs=n_jobs, rate_hz=rate_hz, **kwargs)
+    ensembles = train_ensembles(runs, seeds=seeds, targets=("measured",), n_jobs=n_jobs)
+    rows = []
+    for k, run in runs.items():
+        bias = error_pct(target_time(run), run.measured_s, signed=True)
+        row = {"pocket": k, "rate_hz": rate_hz, "bias_err_pct": bias,
+               "records_per_s": len(run.records.t_s) / run.measured_s}  # fmt: skip
+        for name, short in (("model #1", "m1"), ("model #2", "m2")):
+            t, _ = predict_time(ensembles[name, "measured"], run)
+            row[f"{short}_err_pct"] = error_pct(t, run.measured_s, signed=True)
+        rows.append(row)
     return pd.DataFrame(rows)
 
 

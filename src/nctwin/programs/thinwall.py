@@ -18,7 +18,7 @@ remote position), and rapids down to 1 mm above the floor of the level before fe
 regions are cut left to right, also one towards +X (the paper's Fig. 13).
 
 The pockets' lengths and trochoid loops (:data:`POCKETS`) are calibrated to the paper's
-conditions by :mod:`nctwin.programs.thinwall_calibrate`: each pocket's CAD/CAM time and the
+conditions by :mod:`nctwin.chapters.sun2022_part`: each pocket's CAD/CAM time and the
 CAD/CAM error on the chapter's machine (Table 3), and pocket 1's cutter locations.
 """
 
@@ -124,7 +124,7 @@ class PocketSpec:
 #: The eight pockets, 4 x 2 on a part of about 670 x 240 mm with walls of about 3 mm between the
 #: regions the cutter (20 mm) sweeps. Shape, feed, outline corner radius, depth levels and the
 #: short side are the part's; the rest is calibrated before any network is trained
-#: (:func:`nctwin.programs.thinwall_calibrate.calibrate_pocket`), against the paper's conditions
+#: (:func:`nctwin.chapters.sun2022_part.calibrate_pocket`), against the paper's conditions
 #: only: the length (the longer side; the regions' height on the two-region pocket 8) so that the
 #: CAD/CAM time is Table 3's, the trochoid radius so that the machine's time over CAD/CAM's gives
 #: Table 3's CAD/CAM error, and pocket 1's trochoid advance so that it has the paper's 5383 cutter

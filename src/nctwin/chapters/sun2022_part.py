@@ -37,13 +37,11 @@ from ..estimate.cam import cam
 from ..gcode import parse
 from ..kernel import fir
 from ..machine import Profile, load_profile
+from ..programs.thinwall import POCKETS, PocketSpec, pocket_program, start_mm
 from ..report.tables import error_pct, load_paper_table
-from .thinwall import POCKETS, PocketSpec, pocket_program, start_mm
+from .sun2022_claims import CAM_POINTS, CAM_TIME_TOL_PCT, CL_TOL_PCT
 
 __all__ = [
-    "CAM_POINTS",
-    "CAM_TIME_TOL_PCT",
-    "CL_TOL_PCT",
     "PROFILE",
     "PocketTimes",
     "calibrate",
@@ -54,13 +52,6 @@ __all__ = [
 
 #: The chapter's machine.
 PROFILE = "sun2022_siemens"
-
-#: The conditions' bands (the chapter's, :mod:`nctwin.chapters.sun2022_claims`): CAD/CAM time
-#: within 2 % of Table 3, CAD/CAM error within 2 points of it, pocket 1's cutter locations
-#: within 2 % of the paper's.
-CAM_TIME_TOL_PCT = 2.0
-CAM_POINTS = 2.0
-CL_TOL_PCT = 2.0
 
 #: The calibration aims at the middle of each band: it stops once every residual is within this
 #: share of its half-width.
