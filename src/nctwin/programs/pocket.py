@@ -279,14 +279,23 @@ def pocket_program(
     return _program_text(path, feed_mm_s, tol_mm)
 
 
-def _program_text(path_mm: np.ndarray, feed_mm_s: float, tol_mm: float | None) -> str:
+def _program_text(
+    path_mm: np.ndarray,
+    feed_mm_s: float,
+    tol_mm: float | None,
+    title: str = "contour-parallel offsets around an island, middle out",
+) -> str:
     """G-code of a tool-centre path, shape (n, 2): rounded to 0.1 um, repeated points dropped,
-    a plunge at its first point, then one G1 per point."""
+    a plunge at its first point, then one G1 per point; ``title`` is its first comment.
+
+    Raises ValueError unless ``feed_mm_s`` is in (0, 1000] and ``tol_mm`` (if given) positive."""
+    check_range("feed_mm_s", feed_mm_s, 0.0, 1000.0, low_open=True)
+    if tol_mm is not None:
+        check_range("tol_mm", tol_mm, 0.0, math.inf, low_open=True)
     path = np.round(path_mm, 4)
     keep = np.append(True, (np.diff(path, axis=0) != 0).any(axis=1))
     path = path[keep]
-    lines = ["(nctwin pocket: contour-parallel offsets around an island, middle out)",
-             "G21 G90 G17"]  # fmt: skip
+    lines = [f"(nctwin pocket: {title})", "G21 G90 G17"]
     if tol_mm is not None:
         lines.append(f"G64 P{tol_mm:g}")
     lines += [
@@ -359,9 +368,6 @@ def paper_pocket_program(name: str, *, feed_mm_s: float, tol_mm: float | None = 
     -------
     str
     """
-    check_range("feed_mm_s", feed_mm_s, 0.0, 1000.0, low_open=True)
-    if tol_mm is not None:
-        check_range("tol_mm", tol_mm, 0.0, math.inf, low_open=True)
     return _program_text(np.vstack(paper_pocket_rings(name)), feed_mm_s, tol_mm)
 
 
