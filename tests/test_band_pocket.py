@@ -130,7 +130,7 @@ def _distance(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
 
 @settings(max_examples=15, deadline=None)
 @given(
-    scale=st.floats(0.6, 1.6),
+    scale=st.floats(0.5, 2.0),
     band_share=st.floats(0.0, 1.0),
 )
 def test_every_band_gives_one_chain_between_the_walls(scale, band_share):

@@ -312,7 +312,7 @@ def band_pocket_program(spec: PaperPocket, *, feed_mm_s: float, tol_mm: float | 
     :func:`band_pocket_rings` as one chain of G1 moves at one depth, at ``feed_mm_s`` (in
     (0, 1000]) and with a ``G64 P`` blending tolerance ``tol_mm`` (none: the machine's)."""
     path = np.vstack(band_pocket_rings(spec))
-    return _program_text(path, feed_mm_s, tol_mm, "band pocket: zig-zag across the band, "
+    return _program_text(path, feed_mm_s, tol_mm, "zig-zag across the band around an island, "
                          "then a finishing ring along each wall")  # fmt: skip
 
 
