@@ -14,7 +14,7 @@ from nctwin.learn.models import ModelConfig, build
 from nctwin.learn.train import Scaler, TrainConfig, Trained
 from nctwin.methods.chien2023 import features as chien2023_features
 from nctwin.paths import cache_dir
-from nctwin.programs.pocket import paper_pocket_program
+from nctwin.programs.band_pocket import paper_pocket_program
 from nctwin.toolpath import Toolpath
 
 

@@ -28,15 +28,26 @@ def test_cam_conditions_within_two_points_of_each_row():
     assert len(conds) == 4
 
 
-def test_budget_conditions_count_programs_lines_and_families():
+def test_budget_conditions_count_programs_lines_hours_and_families():
     specs = [ProgramSpec("cam", 2000, 70.0, 0.1, k) for k in range(26)]
-    specs += [ProgramSpec("global", 2000, 70.0, 0.1, k) for k in range(4)]
-    conds = {c.id: c for c in cc._budget_conditions("b", specs)}
+    specs += [ProgramSpec("paper_global", 2000, 70.0, 0.1, k) for k in range(4)]
+    conds = {c.id: c for c in cc._budget_conditions("b", specs, 3.5)}
     assert conds["b_train_programs"].ours == 30 and conds["b_train_programs"].met
     assert conds["b_train_lines"].ours == 2000 and conds["b_train_lines"].met
     # 4 of 30 programs of the paper's families: 13.3 %, not all
     assert conds["b_train_families"].ours == pytest.approx(400 / 30)
     assert not conds["b_train_families"].met
+    # the paper's ~3 h of air cutting, within 25 %: 3.5 h is met, 4 h is not
+    assert conds["b_train_hours"].paper == 3 and conds["b_train_hours"].met
+    assert not {c.id: c for c in cc._budget_conditions("b", specs, 4.0)}["b_train_hours"].met
+    # the families as the paper writes them count; the curve-section "global" ones do not
+    literal = [
+        ProgramSpec("paper_mixed", 2000, 70.0, 0.1, 0),
+        ProgramSpec("global", 2000, 70.0, 0.1, 1),
+    ]
+    assert {c.id: c for c in cc._budget_conditions("b", literal, 3.0)}[
+        "b_train_families"
+    ].ours == 50
 
 
 def test_claims_at_the_papers_bars_with_seeds():
@@ -71,3 +82,29 @@ def test_claims_at_the_papers_bars_with_seeds():
     assert set(t3.requires) == {c.id for c in conditions}
     assert claims["cam_underestimates"].whose == "ours" and claims["cam_underestimates"].holds
     assert np.isfinite(claims["table2_bilstm"].value)
+
+
+def test_training_ablation_by_hand():
+    from nctwin.chapters.chien2023 import training_ablation
+
+    rows = pd.DataFrame({"table": ["table1", "table1", "table3"],
+                         "paper_families_err_pct": [1.0, 3.0, 5.0],
+                         "cam_blend_err_pct": [0.5, 1.5, 7.0],
+                         "cam_err_pct": [30.0, 30.0, 12.0]})  # fmt: skip
+    out = training_ablation(rows, {"table1": 2.0, "table3": 6.0}).set_index(["table", "training"])
+    assert list(out.index) == [("table1", "paper_families"), ("table1", "cam_blend"),
+                               ("table3", "paper_families"), ("table3", "cam_blend")]  # fmt: skip
+    assert out.loc[("table1", "paper_families")].tolist() == [2.0, 3.0, 2.0, False]
+    assert out.loc[("table1", "cam_blend")].tolist() == [1.0, 1.5, 2.0, True]
+    assert bool(out.loc[("table3", "paper_families"), "under_bar"])
+    assert not out.loc[("table3", "cam_blend"), "under_bar"]
+
+
+def test_best_share_minimises_the_largest_deviation():
+    from nctwin.chapters.chien2023_calibrate import best_share
+
+    rows = pd.DataFrame({"zigzag_share": [0.1, 0.1, 0.2, 0.2, 0.3, 0.3],
+                         "deviation_pts": [-5.0, 1.0, 2.5, -2.5, 3.0, 0.0]})  # fmt: skip
+    assert best_share(rows) == 0.2
+    # a tie goes to the smallest share
+    assert best_share(rows.assign(deviation_pts=[2.5, 0, 2.5, 0, 3, 0])) == 0.1

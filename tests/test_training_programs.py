@@ -8,9 +8,14 @@ from nctwin.methods.chien2023 import features as chien2023_features
 from nctwin.programs.training import (
     GLOBAL_LENGTH_MM,
     LOCAL_LENGTH_MM,
+    PAPER_ZIGZAG_SHARE,
+    ProgramSpec,
     contour_program,
     global_program,
     mixed_program,
+    paper_contour_program,
+    paper_global_program,
+    paper_mixed_program,
     training_specs,
 )
 
@@ -124,3 +129,45 @@ def test_cam_blend_specs_shares_and_ranges():
     with pytest.raises(ValueError, match="shares"):
         cam_blend_specs(1, n_programs=3, n_lines=10, feed_range_mm_s=(60, 80),
                         tol_range_mm=(0.05, 0.1), shares={"cam": 0.5})  # fmt: skip
+
+
+def test_paper_global_program_turns_at_random_at_every_junction():
+    tp = gcode.parse(paper_global_program(5, n_lines=4000, feed_mm_s=80, tol_mm=0.4))
+    d = tp.end_mm[:, :2] - tp.start_mm[:, :2]
+    heading = np.arctan2(d[:, 1], d[:, 0])
+    turn = np.abs((np.diff(heading) + np.pi) % (2 * np.pi) - np.pi)
+    # a direction change uniform in (0, 2 pi) turns by more than 90 degrees half the time
+    assert abs((turn > np.pi / 2).mean() - 0.5) < 0.03
+    assert tp.lengths_mm.max() < GLOBAL_LENGTH_MM[1] + 1e-3
+    # the curve sections of the older family turn that much at few junctions
+    tp_old = gcode.parse(global_program(5, n_lines=4000, feed_mm_s=80, tol_mm=0.4))
+    d = tp_old.end_mm[:, :2] - tp_old.start_mm[:, :2]
+    heading = np.arctan2(d[:, 1], d[:, 0])
+    assert (np.abs((np.diff(heading) + np.pi) % (2 * np.pi) - np.pi) > np.pi / 2).mean() < 0.05
+
+
+def test_paper_mixed_program_local_share_and_spec_families():
+    tp = gcode.parse(paper_mixed_program(2, n_lines=4000, feed_mm_s=70, tol_mm=0.3))
+    long = tp.lengths_mm > GLOBAL_LENGTH_MM[1] + 1e-3
+    expected = 0.75 * (1 - np.log(1 / 0.5) / np.log(LOCAL_LENGTH_MM[1] / LOCAL_LENGTH_MM[0]))
+    assert abs(long.mean() - expected) < 0.1
+    spec = ProgramSpec("paper_mixed", 4000, 70.0, 0.3, 2)
+    assert spec.text() == paper_mixed_program(2, n_lines=4000, feed_mm_s=70.0, tol_mm=0.3)
+
+
+def test_paper_contour_program_zigzag_share():
+    # the share sets how many sections are zig-zags: none at 0, more at 0.6 than at 0.1
+    def corners(share):
+        tp = gcode.parse(contour_program("I", feed_mm_s=75, tol_mm=0.3, zigzag_share=share))
+        d = tp.end_mm[:, :2] - tp.start_mm[:, :2]
+        heading = np.arctan2(d[:, 1], d[:, 0])
+        return (np.abs((np.diff(heading) + np.pi) % (2 * np.pi) - np.pi) > 0.6 * np.pi).sum()
+
+    assert corners(0.0) < corners(0.1) < corners(0.6)
+    assert paper_contour_program("II", feed_mm_s=75, tol_mm=0.3) == contour_program(
+        "II", feed_mm_s=75, tol_mm=0.3, zigzag_share=PAPER_ZIGZAG_SHARE["II"]
+    )
+    with pytest.raises(ValueError, match="zigzag_share"):
+        contour_program("I", feed_mm_s=75, tol_mm=0.3, zigzag_share=1.5)
+    with pytest.raises(ValueError, match="allowed I, II"):
+        paper_contour_program("III", feed_mm_s=75, tol_mm=0.3)

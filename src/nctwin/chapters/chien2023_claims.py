@@ -24,6 +24,7 @@ __all__ = [
     "CAM_POINTS",
     "FIG9_MAX_TOL_PCT",
     "FIG9_MIN_FACTOR",
+    "HOURS_TOL_PCT",
     "PAPER_FAMILIES",
     "TABLE_CLAIMS",
     "claims",
@@ -38,16 +39,20 @@ CAM_POINTS = 2.0
 FIG9_MIN_FACTOR = 2.0
 #: Fig. 9's highest average feed (straight lines): ours within this tolerance (%).
 FIG9_MAX_TOL_PCT = 10.0
-#: The training families the paper describes (Sec. 3.1).
-PAPER_FAMILIES = ("global", "mixed")
+#: The training families the paper describes (Sec. 3.1), as it writes them.
+PAPER_FAMILIES = ("paper_global", "paper_mixed")
+#: A training set's run time is the paper's within this tolerance (%; it prints "~2 h", "~3 h").
+HOURS_TOL_PCT = 25.0
 #: Per table: (summary quantity of the paper's accuracy, our runs' toolpaths or None for all,
 #: training set).
 TABLE_CLAIMS = {"table1": ("table1_bilstm_accuracy", ("I", "II"), "sim"),
                 "table2": ("table2_bilstm_accuracy", ("pocketing",), "sim"),
                 "table3": ("table3_bilstm_accuracy", ("pocketing",), "b")}  # fmt: skip
 #: Per training set: the summary quantities of the paper's program count and program size.
-_BUDGETS = {"sim": ("sim_train_programs", "sim_train_glines_per_program", "Sec. 4.1"),
-            "b": ("exp_train_programs", "exp_train_blends_per_program", "Sec. 4.2")}  # fmt: skip
+_BUDGETS = {"sim": ("sim_train_programs", "sim_train_glines_per_program", "sim_train_run_time",
+                    "Sec. 4.1"),
+            "b": ("exp_train_programs", "exp_train_blends_per_program", "exp_air_cutting_time",
+                  "Sec. 4.2")}  # fmt: skip
 
 
 def summary_value(quantity: str, column: str = "value") -> float:
@@ -109,10 +114,11 @@ def _cam_conditions(table: str, rows: pd.DataFrame) -> list[Condition]:
             for r in merged.itertuples()]  # fmt: skip
 
 
-def _budget_conditions(name: str, specs: Sequence[ProgramSpec]) -> list[Condition]:
+def _budget_conditions(name: str, specs: Sequence[ProgramSpec], hours: float) -> list[Condition]:
     """A training set's program count and size (within 10 % of the paper's, which prints
-    them as approximate) and its share of programs of the paper's families (all)."""
-    programs, size, section = _BUDGETS[name]
+    them as approximate), its run time (``hours``, within :data:`HOURS_TOL_PCT`) and its share
+    of programs of the paper's families (all)."""
+    programs, size, run_time, section = _BUDGETS[name]
     paper_share = 100.0 * np.mean([s.family in PAPER_FAMILIES for s in specs])
     label = {"sim": "simulation", "b": "machine B"}[name]
     return [
@@ -121,6 +127,9 @@ def _budget_conditions(name: str, specs: Sequence[ProgramSpec]) -> list[Conditio
         Condition(f"{name}_train_lines", f"{section}: G-lines per {label} training program "
                   "(within 10 %)", summary_value(size), float(np.mean([s.n_lines for s in specs])),
                   "G-lines", tol_pct=10.0),
+        Condition(f"{name}_train_hours", f"{section}: run time of the {label} training programs "
+                  f"(within {HOURS_TOL_PCT:g} %)", summary_value(run_time), hours, "h",
+                  tol_pct=HOURS_TOL_PCT),
         Condition(f"{name}_train_families", f"Sec. 3.1: {label} training programs of the "
                   "paper's families, global and mixed (all)", 100.0, paper_share, "%", low=100.0),
     ]  # fmt: skip
@@ -132,6 +141,7 @@ def paper_conditions(
     pocket_stats: pd.DataFrame,
     fig9_feed_mm_s: np.ndarray,
     sets: dict[str, Sequence[ProgramSpec]],
+    train_hours: dict[str, float],
 ) -> list[Condition]:
     """The paper's conditions beside ours, the tolerances fixed in this module.
 
@@ -149,6 +159,8 @@ def paper_conditions(
         Measured average feed per G-line of the Table 2 pocket at Fig. 9's feed and tolerance.
     sets : dict
         ``"sim"`` and ``"b"`` -> the training programs' specs.
+    train_hours : dict
+        ``"sim"`` and ``"b"`` -> the measured run time of those programs (h).
 
     Returns
     -------
@@ -189,7 +201,7 @@ def paper_conditions(
                   tol_pct=FIG9_MAX_TOL_PCT),
     ]  # fmt: skip
     for name in ("sim", "b"):
-        out += _budget_conditions(name, sets[name])
+        out += _budget_conditions(name, sets[name], train_hours[name])
     return out
 
 

@@ -150,7 +150,7 @@ def cam_blend_specs(
     ValueError
         If ``n_programs < 1``, ``n_lines < 2``, a family is unknown or the shares do not sum to 1.
     """
-    known = ("global", "mixed", "cam")
+    known = ("global", "mixed", "paper_global", "paper_mixed", "cam")
     if set(shares) - set(known) or not math.isclose(sum(shares.values()), 1.0):
         raise ValueError(f"shares = {shares!r}: families of {', '.join(known)} summing to 1")
     names = list(shares)

@@ -24,19 +24,17 @@ contour-parallel offsets:
   them (stay-down linking), so the program is one chain of feed moves at one depth.
 * **Arcs** (fillets, the arcs of the island's offsets) are written as chords within
   ``chord_tol_mm`` of the arc, as a CAM post-processor that outputs only G1 does.
-* **Corner zones** (:func:`paper_pocket_program` only): the sharp corners of every offset are
+* **Corner zones** (:func:`pocket_rings` only): the sharp corners of every offset are
   rounded by an arc of ``corner_radius_mm``, as CAM systems smooth the corners of their offsets,
   so each becomes a few short chords between two long lines that meet them tangentially.
 
-:func:`paper_pocket_program` scales this part to the pockets of Chien et al. (2023) Tables 2
-and 3 (:data:`PAPER_POCKETS`), each setting fixed by one statistic the paper publishes;
-:func:`pocket_stats` gives the statistics of a path.
+:func:`pocket_stats` gives the statistics of a path; the pockets of Chien et al. (2023)
+Tables 2 and 3 are :mod:`nctwin.programs.band_pocket`.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -45,10 +43,6 @@ from ..checks import check_range
 __all__ = [
     "BAND_MM",
     "OUTLINE_MM",
-    "PAPER_POCKETS",
-    "PaperPocket",
-    "paper_pocket_program",
-    "paper_pocket_rings",
     "pocket_program",
     "pocket_rings",
     "pocket_stats",
@@ -75,14 +69,6 @@ OUTLINE_MM = (
 #: Width of the floor between the outline and the island (mm); the island is the outline offset
 #: inward by this distance (its corners sharp where the outline's fillet is smaller).
 BAND_MM = 42.0
-#: Scale of the Table 2 pocket: its path is 12.40 m, the mean of the 11.5-13.1 m that Table 2's
-#: CAM times imply.
-SCALE_TABLE2 = 1.076
-#: Scale of the Table 3 pocket: 4.60 m, the path nearest 4.4 m that the offsets' steps allow
-#: (a scale of 0.666 gives 4.18 m).
-SCALE_TABLE3 = 0.668
-#: Chordal tolerance of the paper's pockets: 4993 G-lines in the Table 2 pocket (paper: 5000).
-CHORD_TOL_PAPER_MM = 0.00145
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -193,9 +179,9 @@ def pocket_rings(
     shape (n_i, 2).
 
     See the module docstring; the parameters are those of :func:`pocket_program`, and
-    ``outline_scale`` (the outline, its fillets and the band scaled about the origin) and
-    ``corner_radius_mm`` (every sharp corner of a ring rounded with an arc of this radius, as a
-    CAM system smooths the corners of its offsets; 0: sharp) those of :func:`paper_pocket_program`.
+    ``outline_scale`` scales the outline, its fillets and the band about the origin, and
+    ``corner_radius_mm`` rounds every sharp corner of a ring with an arc of this radius, as a
+    CAM system smooths the corners of its offsets (0: sharp).
     """
     verts = outline_scale * np.array([p for p, _ in OUTLINE_MM])
     radii = outline_scale * np.array([r for _, r in OUTLINE_MM])
@@ -307,68 +293,6 @@ def _program_text(
     lines += [f"G1 X{x:.4f} Y{y:.4f}" for x, y in path[1:]]
     lines += ["G0 Z5", "M30"]
     return "\n".join(lines) + "\n"
-
-
-@dataclass(frozen=True)
-class PaperPocket:
-    r"""The CAM settings of one of the paper's pockets, each fixed by one published statistic.
-
-    Parameters
-    ----------
-    outline_scale : float
-        Scale of :data:`OUTLINE_MM` and :data:`BAND_MM`: fixed by the path length the paper's
-        CAM times imply (:math:`\sum l_k = T_\mathrm{CAM} F`).
-    chord_tol_mm : float
-        Chordal tolerance of the arcs: fixed by the number of G-lines.
-    corner_radius_mm : float
-        Radius that rounds the sharp corners of the offsets (the corner zones): 10 % of the tool
-        diameter, a CAM system's usual corner smoothing.
-    tool_radius_mm, stepover_mm : float
-        The 8 mm end mill and the 2 mm stepover of :func:`pocket_program`.
-    """
-
-    outline_scale: float
-    chord_tol_mm: float
-    corner_radius_mm: float = 0.8
-    tool_radius_mm: float = 4.0
-    stepover_mm: float = 2.0
-
-
-#: The pockets of Tables 2 and 3. Table 2: CAM times 125-174 s at 75 and 92 mm/s imply
-#: 11.5-13.1 m of path (mean 12.4 m) and the text gives 5000 G-lines. Table 3: 55-63 s at 70 and
-#: 80 mm/s imply 4.3-4.5 m (mean 4.4 m); the same CAM settings, a smaller part. The scales and
-#: the chordal tolerance were solved for those statistics (:func:`pocket_stats`) and frozen.
-PAPER_POCKETS = {
-    "table2": PaperPocket(outline_scale=SCALE_TABLE2, chord_tol_mm=CHORD_TOL_PAPER_MM),
-    "table3": PaperPocket(outline_scale=SCALE_TABLE3, chord_tol_mm=CHORD_TOL_PAPER_MM),
-}
-
-
-def paper_pocket_rings(name: str) -> list[np.ndarray]:
-    """The tool-centre rings of :data:`PAPER_POCKETS` ``[name]`` (see :func:`pocket_rings`)."""
-    if name not in PAPER_POCKETS:
-        raise ValueError(f"name = {name!r} is unknown: allowed {', '.join(PAPER_POCKETS)}")
-    return pocket_rings(**asdict(PAPER_POCKETS[name]))
-
-
-def paper_pocket_program(name: str, *, feed_mm_s: float, tol_mm: float | None = None) -> str:
-    """G-code of the pocket of Chien et al. (2023) Table 2 (``"table2"``) or Table 3
-    (``"table3"``): :func:`pocket_program`'s part at the scale of :data:`PAPER_POCKETS`, its
-    offsets' sharp corners rounded by short chords.
-
-    Parameters
-    ----------
-    name : {"table2", "table3"}
-    feed_mm_s : float
-        Programmed feed, in (0, 1000].
-    tol_mm : float, optional
-        A ``G64 P`` blending tolerance; none: the machine's.
-
-    Returns
-    -------
-    str
-    """
-    return _program_text(np.vstack(paper_pocket_rings(name)), feed_mm_s, tol_mm)
 
 
 def pocket_stats(path_mm: np.ndarray, *, short_mm: float = 1.0) -> dict[str, float]:

@@ -17,6 +17,14 @@ Two families of *training* programs (Sec. 3.1, Fig. 6), planar, linear G-lines o
   common as lines of hundreds: a uniform draw would make 99 % of them longer than 10 mm. Half
   the local runs leave the curve before them tangentially, as lines meet arcs in real parts.
 
+The families as the paper writes them, ``"paper_global"`` and ``"paper_mixed"``
+(:func:`paper_global_program`, :func:`paper_mixed_program`): the same lengths, but the direction
+turns by an angle drawn uniformly in :math:`(-\pi, \pi)` (a direction change
+:math:`\theta_k \in (0, 2\pi)`) at *every* junction, global and local alike, with no curve and no
+tangential exits. Their global lines are a random walk of sub-millimetre steps: half their
+junctions turn by more than 90 degrees, where the curve sections above turn by more than 90
+degrees at about one junction in forty.
+
 Two *test* contours (Table 1, "toolpath I" and "toolpath II", Fig. 7): closed-free chains of
 straight lines, sharp zig-zags (local blends of short lines), and smooth curves discretised into
 short chords (global blends), in a fixed random order. Toolpath II has about 6 times the
@@ -34,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import check_range
+
 __all__ = [
     "GLOBAL_LENGTH_MM",
     "LOCAL_LENGTH_MM",
@@ -43,6 +53,9 @@ __all__ = [
     "contour_program",
     "global_program",
     "mixed_program",
+    "paper_contour_program",
+    "paper_global_program",
+    "paper_mixed_program",
     "program_text",
     "specs_of",
     "training_specs",
@@ -107,11 +120,17 @@ def program_text(points_mm: np.ndarray, *, feed_mm_s: float, tol_mm: float, titl
 
 
 def _global_section(
-    rng: np.random.Generator, n: int, length_mm: tuple[float, float] | None = None
+    rng: np.random.Generator,
+    n: int,
+    length_mm: tuple[float, float] | None = None,
+    literal: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Short lines on a curve: in half the sections of random lengths, in the other half of one
+    r"""Short lines on a curve: in half the sections of random lengths, in the other half of one
     length (a CAM system's constant chord). Lengths are uniform in :data:`GLOBAL_LENGTH_MM`, or
-    log-uniform in ``length_mm`` where given."""
+    log-uniform in ``length_mm`` where given. ``literal``: the paper's lines, lengths uniform in
+    :data:`GLOBAL_LENGTH_MM` and a uniform turn in :math:`(-\pi, \pi)` at every junction."""
+    if literal:
+        return rng.uniform(*GLOBAL_LENGTH_MM, n), rng.uniform(-math.pi, math.pi, n)
 
     def draw(size=None):
         if length_mm is None:
@@ -122,11 +141,14 @@ def _global_section(
     return lengths, _global_turns(rng, lengths)
 
 
-def _local_section(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _local_section(
+    rng: np.random.Generator, n: int, literal: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Long lines with random direction changes; in half the runs the first line leaves the
-    section before it tangentially (a line meeting a curve, as in pockets and contours)."""
+    section before it tangentially (a line meeting a curve, as in pockets and contours), unless
+    ``literal`` (the paper's random direction changes only)."""
     turns = rng.uniform(-math.pi, math.pi, n)
-    if rng.random() < 0.5:
+    if not literal and rng.random() < 0.5:
         turns[0] = 0.0
     return _log_uniform(rng, *LOCAL_LENGTH_MM, n), turns
 
@@ -136,18 +158,19 @@ def _sections(
     n_lines: int,
     local_share: float,
     global_length_mm: tuple[float, float] | None = None,
+    literal: bool = False,
 ):
     """Lengths and turns of ``n_lines`` G-lines: sections of 10-80 lines, local with
     probability ``local_share`` (by G-line count, on average); see :func:`_global_section` for
-    ``global_length_mm``."""
+    ``global_length_mm`` and ``literal``."""
     lengths, turns, count = [], [], 0
     while count < n_lines:
         n = min(int(rng.integers(*SECTION_LINES, endpoint=True)), n_lines - count)
         local = rng.random() < local_share
         if local:
-            ln, tn = _local_section(rng, n)
+            ln, tn = _local_section(rng, n, literal)
         else:
-            ln, tn = _global_section(rng, n, global_length_mm)
+            ln, tn = _global_section(rng, n, global_length_mm, literal)
         lengths.append(ln)
         turns.append(tn)
         count += n
@@ -155,9 +178,15 @@ def _sections(
 
 
 def global_program(
-    seed: int | np.random.Generator, *, n_lines: int = 1000, feed_mm_s: float, tol_mm: float
+    seed: int | np.random.Generator,
+    *,
+    n_lines: int = 1000,
+    feed_mm_s: float,
+    tol_mm: float,
+    literal: bool = False,
 ) -> str:
-    """A "global blending" training program (Sec. 3.1, Fig. 6a): short lines on random curves.
+    """A "global blending" training program (Sec. 3.1, Fig. 6a): short lines on random curves,
+    or with ``literal`` the paper's random turn at every junction (:func:`paper_global_program`).
 
     Parameters
     ----------
@@ -166,6 +195,8 @@ def global_program(
         Number of G1 lines.
     feed_mm_s, tol_mm : float
         Programmed feed and ``G64 P`` blending tolerance.
+    literal : bool
+        The paper's lines (see the module docstring).
 
     Returns
     -------
@@ -173,10 +204,11 @@ def global_program(
         G-code text.
     """
     rng = _rng(seed)
-    lengths, turns = _sections(rng, n_lines, local_share=0.0)
+    lengths, turns = _sections(rng, n_lines, local_share=0.0, literal=literal)
+    kind = "paper global" if literal else "global"
     return program_text(
         _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
-        title=f"nctwin global training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
+        title=f"nctwin {kind} training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
     )  # fmt: skip
 
 
@@ -187,6 +219,7 @@ def mixed_program(
     feed_mm_s: float,
     tol_mm: float,
     local_share: float = 0.75,
+    literal: bool = False,
 ) -> str:
     """A "mixed" training program (Sec. 3.1, Fig. 6b): 75 % local, 25 % global G-lines.
 
@@ -199,6 +232,8 @@ def mixed_program(
         Programmed feed and ``G64 P`` blending tolerance.
     local_share : float
         Expected share of G-lines in local sections.
+    literal : bool
+        The paper's lines (see the module docstring).
 
     Returns
     -------
@@ -208,16 +243,34 @@ def mixed_program(
     if not 0.0 <= local_share <= 1.0:
         raise ValueError(f"local_share = {local_share!r} is out of range: allowed [0, 1]")
     rng = _rng(seed)
-    lengths, turns = _sections(rng, n_lines, local_share=local_share)
+    lengths, turns = _sections(rng, n_lines, local_share=local_share, literal=literal)
+    kind = "paper mixed" if literal else "mixed"
     return program_text(
         _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
-        title=f"nctwin mixed training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
+        title=f"nctwin {kind} training program: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
     )  # fmt: skip
+
+
+def paper_global_program(
+    seed: int | np.random.Generator, *, n_lines: int = 1000, feed_mm_s: float, tol_mm: float
+) -> str:
+    """The paper's "global" family as written (Sec. 3.1): lines of (0, 1) mm, a uniform turn at
+    every junction (:func:`global_program` with ``literal=True``)."""
+    return global_program(seed, n_lines=n_lines, feed_mm_s=feed_mm_s, tol_mm=tol_mm, literal=True)
+
+
+def paper_mixed_program(
+    seed: int | np.random.Generator, *, n_lines: int = 1000, feed_mm_s: float, tol_mm: float
+) -> str:
+    """The paper's "mixed" family as written (Sec. 3.1): 75 % local lines, 25 % global, a uniform
+    turn at every junction (:func:`mixed_program` with ``literal=True``)."""
+    return mixed_program(seed, n_lines=n_lines, feed_mm_s=feed_mm_s, tol_mm=tol_mm, literal=True)
 
 
 @dataclass(frozen=True)
 class ProgramSpec:
-    """One training program: its family, size, feed, tolerance and seed."""
+    """One training program: its family (``"global"``, ``"mixed"``, ``"paper_global"``,
+    ``"paper_mixed"``), size, feed, tolerance and seed."""
 
     family: str
     n_lines: int
@@ -227,7 +280,9 @@ class ProgramSpec:
 
     def text(self) -> str:
         """The program's G-code."""
-        make = {"global": global_program, "mixed": mixed_program}[self.family]
+        make = {"global": global_program, "mixed": mixed_program,
+                "paper_global": paper_global_program, "paper_mixed": paper_mixed_program}[
+            self.family]  # fmt: skip
         return make(self.seed, n_lines=self.n_lines, feed_mm_s=self.feed_mm_s, tol_mm=self.tol_mm)
 
 
@@ -343,11 +398,21 @@ def broad_program(
 TEST_SECTIONS = {"I": 42, "II": 250}
 #: Seeds of the test contours (fixed: the contours are part of the chapter, like the paper's).
 TEST_SEEDS = {"I": 1001, "II": 1002}
+#: Zig-zag share of the paper's toolpaths I and II (:func:`paper_contour_program`), fixed by
+#: CAM's error on Table 1's four rows of each on ``paper1_sim``: the share, on a grid of 0.01 in
+#: [0.20, 0.35], whose largest deviation from the paper's rows is smallest (the smallest on a tie)
+#: (:func:`nctwin.chapters.chien2023_calibrate.zigzag_share_rows`).
+PAPER_ZIGZAG_SHARE = {"I": 0.27, "II": 0.28}
 
 
-def _test_section(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """One section of a test contour: a straight, a sharp zig-zag or a smooth curve."""
-    kind = rng.choice(["straight", "zigzag", "curve"], p=[0.25, 0.35, 0.4])
+def _test_section(
+    rng: np.random.Generator, zigzag_share: float = 0.35
+) -> tuple[np.ndarray, np.ndarray]:
+    """One section of a test contour: a sharp zig-zag with probability ``zigzag_share``, else a
+    straight or a smooth curve in the ratio 25 : 40."""
+    rest = 1.0 - zigzag_share
+    p = [rest * 25 / 65, zigzag_share, rest * 40 / 65]
+    kind = rng.choice(["straight", "zigzag", "curve"], p=p)
     if kind == "straight":
         n = int(rng.integers(1, 4))
         return rng.uniform(15.0, 60.0, n), rng.uniform(-0.5, 0.5, n) * math.pi
@@ -366,7 +431,9 @@ def _test_section(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     return lengths, turns
 
 
-def contour_program(name: str, *, feed_mm_s: float, tol_mm: float) -> str:
+def contour_program(
+    name: str, *, feed_mm_s: float, tol_mm: float, zigzag_share: float = 0.35
+) -> str:
     """Test toolpath I or II of Table 1: a complex planar contour with sharp and smooth sections.
 
     Parameters
@@ -374,6 +441,8 @@ def contour_program(name: str, *, feed_mm_s: float, tol_mm: float) -> str:
     name : {"I", "II"}
     feed_mm_s, tol_mm : float
         Programmed feed and ``G64 P`` blending tolerance.
+    zigzag_share : float
+        Probability of a zig-zag section, in [0, 1].
 
     Returns
     -------
@@ -382,11 +451,22 @@ def contour_program(name: str, *, feed_mm_s: float, tol_mm: float) -> str:
     """
     if name not in TEST_SECTIONS:
         raise ValueError(f"name = {name!r} is unknown: allowed {', '.join(TEST_SECTIONS)}")
+    check_range("zigzag_share", zigzag_share, 0.0, 1.0)
     rng = np.random.default_rng(TEST_SEEDS[name])
-    parts = [_test_section(rng) for _ in range(TEST_SECTIONS[name])]
+    parts = [_test_section(rng, zigzag_share) for _ in range(TEST_SECTIONS[name])]
     lengths = np.concatenate([p[0] for p in parts])
     turns = np.concatenate([p[1] for p in parts])
     return program_text(
         _polyline(lengths, turns), feed_mm_s=feed_mm_s, tol_mm=tol_mm,
         title=f"nctwin test toolpath {name}: F {feed_mm_s:g} mm/s, eps {tol_mm:g} mm",
     )  # fmt: skip
+
+
+def paper_contour_program(name: str, *, feed_mm_s: float, tol_mm: float) -> str:
+    """Toolpath I or II of the paper's Table 1: :func:`contour_program` with the zig-zag share
+    of :data:`PAPER_ZIGZAG_SHARE`."""
+    if name not in PAPER_ZIGZAG_SHARE:
+        raise ValueError(f"name = {name!r} is unknown: allowed {', '.join(PAPER_ZIGZAG_SHARE)}")
+    return contour_program(
+        name, feed_mm_s=feed_mm_s, tol_mm=tol_mm, zigzag_share=PAPER_ZIGZAG_SHARE[name]
+    )
