@@ -333,7 +333,10 @@ def arc_junction_blends(
 
 
 def parabolic_directions(
-    moves: Toolpath, overall_acc_mm_s2: np.ndarray, req_speed_mm_s: np.ndarray
+    moves: Toolpath,
+    overall_acc_mm_s2: np.ndarray,
+    req_speed_mm_s: np.ndarray,
+    arc_rules: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Directions at the end and at the start of M moves whose angle sets a parabolic blend's
     speed (``tpComputeBlendVelocity``: ``tcGetEndAccelUnitVector``,
@@ -353,10 +356,12 @@ def parabolic_directions(
         M moves of non-zero length.
     overall_acc_mm_s2, req_speed_mm_s : ndarray, shape (M,)
         Each move's overall acceleration and requested feed (used on arcs only).
+    arc_rules : bool
+        False: the tangents, arcs' too (the planner's ablation).
     """
     end, start = moves.end_tangents.copy(), moves.start_tangents.copy()
     arc = np.flatnonzero(moves.is_arc)
-    if not len(arc):
+    if not (len(arc) and arc_rules):
         return end, start
     rows = np.arange(len(arc))
     normal_axis = moves._plane_axes[arc, 2]
@@ -440,6 +445,7 @@ def arc_junctions(
     axis_acc_mm_s2: np.ndarray,
     axis_vel_mm_s: np.ndarray,
     period_s: float,
+    arc_rules: bool = True,
 ) -> dict[str, np.ndarray]:
     r"""What LinuxCNC makes of the junctions of M moves marked ``candidates`` (rules 1-6 of the
     module docstring), shapes (M - 1,).
@@ -467,6 +473,8 @@ def arc_junctions(
         rest).
     axis_acc_mm_s2, axis_vel_mm_s : ndarray, shape (3,)
     period_s : float
+    arc_rules : bool
+        The parabolic blend's directions (:func:`parabolic_directions`).
 
     Returns
     -------
@@ -531,7 +539,7 @@ def arc_junctions(
     acc2 = path_acc_mm_s2[j + 1] * scale * np.where(arc[j + 1], 0.5, 1.0)
     # the angle of the parabolic blend from its own directions, the next move at its
     # overall acceleration then (its parabolic end and the kink)
-    d_end, d_start = parabolic_directions(moves, path_acc_mm_s2 * scale, req_speed_mm_s)
+    d_end, d_start = parabolic_directions(moves, path_acc_mm_s2 * scale, req_speed_mm_s, arc_rules)
     parabolic = parabolic_performance(
         length[j], length[j + 1], speed_mm_s[j], speed_mm_s[j + 1], acc1, acc2,
         np.einsum("ij,ij->i", d_end[j], d_start[j + 1]), tol_mm[j],

@@ -478,6 +478,7 @@ def blend_planner(
     kinks: bool = True,
     sized_arcs: bool = True,
     arc_blends: bool = True,
+    arc_rules: bool = True,
     stop_periods: str = "whole",
     stop_turn_rad: float = STOP_TURN_RAD,
 ) -> Estimate:
@@ -499,6 +500,11 @@ def blend_planner(
         LinuxCNC's blend arcs at junctions with a programmed arc, and what replaces them where
         they fail or are slower (:func:`~nctwin.estimate.blend_junctions.arc_junctions`); on by
         default (needs ``kinks``), off for the ablation: the line-line formula on the tangents.
+    arc_rules : bool
+        LinuxCNC's rules for programmed arcs: the tangential acceleration from the arc's speed
+        limit (:func:`move_limits`) and the directions of parabolic blends at arcs
+        (:func:`~nctwin.estimate.blend_junctions.parabolic_directions`); on by default, off
+        for the ablation: the acceleration from the feed and the blends on the tangents.
     stop_periods : {"whole", "mean", "off"}
         ``whole``: the tool comes to rest on a servo period (:func:`stops_on_periods`), as on
         LinuxCNC; ``mean``: each stop adds half a period instead, the mean of the same on
@@ -531,7 +537,9 @@ def blend_planner(
     parabolic_end = np.zeros(len(moves), bool)
     parabolic_end[after[(after > 0) & (after <= len(moves))] - 1] = True
     parabolic_end[-1] = True
-    limits = functools.partial(move_limits, finalized=~parabolic_end)
+    limits = functools.partial(
+        move_limits, finalized=~parabolic_end, arc_ratio="max_speed" if arc_rules else "feed"
+    )
     feed, acc = limits(moves, machine)
     parabolic_end &= tol > 0
     tol[after[after < len(moves)]] = 0.0
@@ -570,7 +578,7 @@ def blend_planner(
     req_speed = limits(moves, machine, finalized=np.zeros(len(moves), bool))[0]  # reqvel
     choice = arc_junctions(
         moves, candidates, speed, req_speed, path_acc, tol[1:], kink, line_trim, axis_acc,
-        axis_vel, control.period_s,
+        axis_vel, control.period_s, arc_rules,
     )  # fmt: skip
     kinked = choice["choice"] == TANGENT_BLEND
     reduce = np.where(tangent, kink, np.where(exact | kinked, KINK_RATIO, 0.0))
@@ -605,7 +613,7 @@ def blend_planner(
     if para.any():
         share = kept * np.where(halved, TANGENTIAL_ACC_RATIO, 1.0)
         feed, acc = limits(moves, machine, share)
-        u_end, u_start = parabolic_directions(moves, path_acc * share, req_speed)
+        u_end, u_start = parabolic_directions(moves, path_acc * share, req_speed, arc_rules)
         # each move as long as the blends at its other ends leave it (its target)
         d_end, d_start = (np.where(para, 0.0, x) for x in (d_end, d_start))
         target = length - np.concatenate([[0.0], d_start]) - np.concatenate([d_end, [0.0]])
