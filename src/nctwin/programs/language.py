@@ -281,8 +281,8 @@ def plane_arcs() -> str:
     """Arcs and helices in the ZX (G18) and YZ (G19) planes, where Z's lower limits (100 mm/s,
     500 mm/s^2 on ``linuxcnc_sim``) bound the arc: half, quarter and full circles of 2-40 mm
     radius at 10-100 mm/s, joined to lines at right angles, tangentially, by a reversal and to
-    each other; a helical half turn in each plane and a full helical turn; a G61 section, a
-    dwell after an arc, and an arc as the last move."""
+    each other; a helical half turn in each plane and a full helical turn; a dwell after an
+    arc, and an arc as the last move."""
     return """\
 (nctwin language program: arcs and helices in the ZX and YZ planes)
 G21 G17 G90 G94 G40 G49 G80
@@ -322,14 +322,13 @@ G3 Y175 Z80 X210 J10 K0 F1500
 G1 Y185 F2000
 (a full helical turn of 5 mm back 5 mm in X)
 G2 Y185 Z80 X205 J5 K0 F3000
-(exact stop between rapids: a half circle of 5 mm and a line)
-G61
+(a plunge, a half circle of 5 mm and a line between rapids, then a wider tolerance)
 G0 Z85
 G1 Z80 F1200
 G2 Y195 Z80 J5 K0
 G1 Y205
-G64 P0.05
 G0 Z85
+G64 P0.05
 (a dwell after a G18 half circle, and a G18 arc to end the program)
 G1 Z80 F2400
 G18 G2 X225 Z80 I10 K0
