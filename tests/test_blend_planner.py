@@ -372,3 +372,14 @@ def test_g61_stops_without_a_kink_at_a_reversal_and_between_rapid_and_feed():
     expected = 2 * math.sqrt(5 / 500) + 5 / 5 + 5 / 500
     assert time_s("G21 G90 G61\nG0 Z-5\nG1 Z-10 F300\n") == pytest.approx(expected, abs=0.001)
     assert expected == pytest.approx(1.210)
+
+
+def test_a_junction_takes_the_mode_of_the_move_before_it():
+    # LinuxCNC gives each move the term condition in force when it is queued, and the junction
+    # after it uses that move's (tcSetupState): G61 then G64 stops at the first corner, G64
+    # then G61 blends it; the second corner the other way round. Swapping the modes changes
+    # the time only through that (LinuxCNC: 1.397 s and 1.356 s)
+    stop_first = time_s("G21 G90 G61\nG1 X20 F3000\nG64 P0.05\nG1 Y20\nG1 X0\n")
+    blend_first = time_s("G21 G90 G64 P0.05\nG1 X20 F3000\nG61\nG1 Y20\nG1 X0\n")
+    assert stop_first == pytest.approx(1.397, abs=0.001)
+    assert blend_first == pytest.approx(1.356, abs=0.001)

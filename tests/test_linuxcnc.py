@@ -228,6 +228,9 @@ PLANNER_PROGRAMS = {
     "g18_half_last": "G21 G90 G64 P0.01\nG18 G1 X10 F1200\nG2 X30 Z0 I10 K0\nM2\n",
     "g18_r100_g61": "G21 G90 G61\nG18 G1 X10 F3000\nG2 X210 Z0 I100 K0\nG1 Z-10\nM2\n",
     "g19_helix": "G21 G90 G64 P0.01\nG19 G1 Y10 F3000\nG3 Y10 Z0 X20 J5 K0\nG1 Z-10\nM2\n",
+    # a change of path-control mode: the junction takes the mode of the move before it
+    "g61_then_g64": "G21 G90 G61\nG1 X20 F3000\nG64 P0.05\nG1 Y20\nG1 X0\nM2\n",
+    "g64_then_g61": "G21 G90 G64 P0.05\nG1 X20 F3000\nG61\nG1 Y20\nG1 X0\nM2\n",
     "g61_stops": "G21 G90 G61\nG1 F1800\n"
     + "".join(
         f"X{20 * math.sin(k / 20):.4f} Y{20 - 20 * math.cos(k / 20):.4f}\n" for k in range(1, 11)
