@@ -26,7 +26,7 @@ tangent :math:`u_1`, the second starting along :math:`u_2`:
   the move (``tcFindBlendTolerance``); the junction blends, stops or passes exactly as the mode
   of the move before it says (``tcSetupState``: a move keeps the mode in force when it is
   queued; checked live, ``G61`` then ``G64 P0.05`` round two corners 1.397 s (1.397), the other
-  way round 1.356 s (1.356; both 15-20 ms off with the mode of the move after));
+  way round 1.356 s (1.356; 15 and 6 ms off with the mode of the move after));
 * the largest distance from the corner along the moves the tolerance allows,
   :math:`d_{tol} = \cos\theta \, T / (1 - \sin\theta)`, and at most half of each move,
   :math:`d_g = \min(d_{tol}, L_1/2, L_2/2)`, the largest radius :math:`R_g = d_g \tan\theta`;
