@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from nctwin.estimate import estimate
+from nctwin.estimate.blend_junctions import parabolic_directions
 from nctwin.estimate.blend_planner import (
     KINK_RATIO,
     MIN_SEGMENT_CYCLES,
@@ -290,3 +291,95 @@ def test_stops_fall_on_servo_periods():
     assert mean == pytest.approx(3 * (7 / 37 + 37 / A + 0.0005))
     with pytest.raises(ValueError, match="stop_periods = 'all' is not allowed: allowed whole"):
         estimate_planner(tp, stop_periods="all")
+
+
+def test_a_g18_circle_is_limited_by_z():
+    # a full circle of r = 10 in the XZ plane at 100 mm/s under G61: canon's ARC_FEED takes the
+    # smaller acceleration of the plane's axes, Z's 500 mm/s^2, so the speed stays within
+    # v = sqrt(0.866 * 500 * 10) = 65.8 mm/s (not 100, Z's velocity); the circle is the last
+    # move, never finalized: tangential acceleration 500 / 2 (LinuxCNC: 1.218 s)
+    v = math.sqrt(NORMAL_ACC_RATIO * 500 * 10)
+    program = "G21 G90 G61\nG18 G2 X0 Z0 I10 K0 F6000\n"
+    feed, acc = move_limits(parse(program, start_mm=(0, 0, 0)), MACHINE)
+    assert feed == pytest.approx([v])
+    assert acc == pytest.approx([250.0])
+    expected = 20 * math.pi / v + v / 250
+    assert expected == pytest.approx(1.218, abs=0.001)
+    assert time_s(program) == pytest.approx(whole_periods(expected))
+
+
+def test_an_arc_splits_its_acceleration_at_its_speed_limit_not_its_feed():
+    # a half circle of r = 100 in XZ at 50 mm/s between two lines, G61: the arc's speed limit is
+    # Z's 100 mm/s; finalized with the kink's 0.9 of 500 mm/s^2 (a' = 450), its normal
+    # acceleration at that limit is 100^2 / 100 = 100 mm/s^2, so the tangential acceleration is
+    # a' sqrt(1 - (100 / a')^2) = 438.8 mm/s^2 (LinuxCNC's trace: 438.5), whatever the feed;
+    # the line after it turns back (a sharp corner): a stop with no kink, 500 mm/s^2
+    program = "G21 G90 G61\nG18 G1 X10 F3000\nG2 X210 Z0 I100 K0\nG1 Z-10\n"
+    moves = parse(program, start_mm=(0, 0, 0))
+    feed, acc = move_limits(moves, MACHINE, np.array([0.9, 0.9, 1.0]))
+    assert feed[1] == pytest.approx(50.0)
+    assert acc[1] == pytest.approx(450 * math.sqrt(1 - (100 / 450) ** 2))
+    # at the feed instead (the rule as first written): 450 sqrt(1 - (25 / 450)^2) = 449.3
+    assert move_limits(moves, MACHINE, np.array([0.9, 0.9, 1.0]), arc_ratio="feed")[1][
+        1
+    ] == pytest.approx(450 * math.sqrt(1 - (25 / 450) ** 2))
+    assert time_s(program) == pytest.approx(6.954, abs=0.001)  # LinuxCNC: 6.954 s
+
+
+def test_a_helix_takes_linuxcncs_effective_radius():
+    # a full turn of r = 5 in YZ rising 20 mm along X, between lines: length
+    # l = sqrt((10 pi)^2 + 20^2); canon's speed limit sqrt(0.866 * 500 * 5) l / (10 pi) (Z's
+    # acceleration, the planar share), the path acceleration min(500 l / (10 pi), 1000 l / 20);
+    # finalized with the effective radius r + h^2 / r = 85 mm (pmCircleEffectiveMinRadius)
+    program = "G21 G90 G61\nG19 G1 Y10 F6000\nG3 Y10 Z0 X20 J5 K0\nG1 Z-10\n"
+    moves = parse(program, start_mm=(0, 0, 0))
+    length = math.hypot(10 * math.pi, 20)
+    v_max = math.sqrt(NORMAL_ACC_RATIO * 500 * 5) * length / (10 * math.pi)
+    a = min(500 * length / (10 * math.pi), 1000 * length / 20)
+    feed, acc = move_limits(moves, MACHINE)
+    assert moves.lengths_mm[1] == pytest.approx(length)
+    assert feed[1] == pytest.approx(v_max)
+    assert acc[1] == pytest.approx(a * math.sqrt(1 - (v_max**2 / 85 / a) ** 2))
+
+
+def test_a_helix_into_a_line_along_its_plane_blends_straight_on():
+    # the YZ helix above ends running along -Z in its plane (and along +X); the line after runs
+    # along -Z: tpComputeBlendVelocity takes the arc's planar tangent, so the parabolic blend
+    # sees no turn and no tolerance limit; its start leans towards the centre by (F / 2)^2 / r
+    moves = parse(
+        "G21 G90 G64 P0.01\nG19 G1 Y10 F3000\nG3 Y10 Z0 X20 J5 K0\nG1 Z-10\n", start_mm=(0, 0, 0)
+    )
+    end, start = parabolic_directions(moves, np.full(3, 300.0), np.full(3, 50.0))
+    np.testing.assert_allclose(end[1], [0, 0, -1], atol=1e-12)
+    lean = 25.0**2 / 5
+    np.testing.assert_allclose(start[1], np.array([0, lean, -300]) / math.hypot(lean, 300))
+    np.testing.assert_allclose(end[0], moves.end_tangents[0])
+    # LinuxCNC: 1.431 s (the 3D tangents: a 33 degree turn held to 5 mm/s, 1.560 s)
+    assert time_s("G21 G90 G64 P0.01\nG19 G1 Y10 F3000\nG3 Y10 Z0 X20 J5 K0\nG1 Z-10\n") == (
+        pytest.approx(1.431, rel=0.005)
+    )
+
+
+def test_g61_stops_without_a_kink_at_a_reversal_and_between_rapid_and_feed():
+    # a reversal (tpSetupTangent's sharp corner) and a change between rapid and feed
+    # (handleModeChange) stop the tool before any kink is set: the moves keep their full
+    # acceleration. 10 mm at 50 mm/s and back at 1000 mm/s^2 (0.25 s each), then 10 mm along Y
+    # after a 90 degree kink, the last two at 0.9 a (LinuxCNC: 0.762 s)
+    turn = 0.25 + whole_periods(0.2 + 50 / 900)
+    assert time_s("G21 G90 G61\nG1 X10 F3000\nX0\nY10\n") == pytest.approx(0.25 + 2 * (turn - 0.25))
+    assert 0.25 + 2 * (turn - 0.25) == pytest.approx(0.762)
+    # 5 mm rapid along Z (triangle at 500 mm/s^2), a stop, 5 mm at 5 mm/s (LinuxCNC: 1.210 s)
+    expected = 2 * math.sqrt(5 / 500) + 5 / 5 + 5 / 500
+    assert time_s("G21 G90 G61\nG0 Z-5\nG1 Z-10 F300\n") == pytest.approx(expected, abs=0.001)
+    assert expected == pytest.approx(1.210)
+
+
+def test_a_junction_takes_the_mode_of_the_move_before_it():
+    # LinuxCNC gives each move the term condition in force when it is queued, and the junction
+    # after it uses that move's (tcSetupState): G61 then G64 stops at the first corner, G64
+    # then G61 blends it; the second corner the other way round. Swapping the modes changes
+    # the time only through that (LinuxCNC: 1.397 s and 1.356 s)
+    stop_first = time_s("G21 G90 G61\nG1 X20 F3000\nG64 P0.05\nG1 Y20\nG1 X0\n")
+    blend_first = time_s("G21 G90 G64 P0.05\nG1 X20 F3000\nG61\nG1 Y20\nG1 X0\n")
+    assert stop_first == pytest.approx(1.397, abs=0.001)
+    assert blend_first == pytest.approx(1.356, abs=0.001)

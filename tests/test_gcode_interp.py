@@ -136,8 +136,9 @@ def test_shared_programs_agree(linuxcnc_interpreter):
         cam_blend_program(0, n_lines=300, feed_mm_s=50.0, tol_mm=0.05),
         finishing3d_program(0),
         LANGUAGE_PROGRAMS["drill_cycles"](),
+        LANGUAGE_PROGRAMS["plane_arcs"](),
     ],
-    ids=["cam0", "cam1", "cam2", "camblend", "finishing3d", "drill_cycles"],
+    ids=["cam0", "cam1", "cam2", "camblend", "finishing3d", "drill_cycles", "plane_arcs"],
 )
 def test_generated_programs_agree(linuxcnc_interpreter, text):
     assert_agree(*_both(text))
@@ -170,7 +171,7 @@ def test_language_programs_are_read_by_linuxcnc(linuxcnc_interpreter):
     for name, make in LANGUAGE_PROGRAMS.items():
         result = read(make())
         assert len(result.toolpath) > 10, name
-        expected = "native" if name == "drill_cycles" else "linuxcnc"
+        expected = "native" if name in ("drill_cycles", "plane_arcs") else "linuxcnc"
         assert result.reader == expected, name
 
 

@@ -159,8 +159,9 @@ def test_exact_stop_at_corner():
 #: depth, a zigzag whose blend arcs lie in the XZ plane (Z's acceleration), a rapid followed
 #: by a feed move (no blend between them), a corner of short moves before a long line (the
 #: lazy look-ahead's dip), slow reversals whose blend arcs are as small as their speed allows,
-#: G61 chords of a circle that LinuxCNC passes as tangent (R 500 mm) or stops at (R 20 mm), and
-#: small kinks next to a programmed arc (nctwin.estimate.blend_junctions).
+#: G61 chords of a circle that LinuxCNC passes as tangent (R 500 mm) or stops at (R 20 mm),
+#: small kinks next to a programmed arc (nctwin.estimate.blend_junctions), and arcs and a helix
+#: outside the XY plane.
 PLANNER_PROGRAMS = {
     "collinear": "G21 G90 G64\nG1 F12000\n" + "".join(f"X{5 * k}\n" for k in range(1, 11)) + "M2\n",
     "corner": "G21 G90 G64 P0.1\nG1 X100 F3000\nY100\nM2\n",
@@ -220,6 +221,16 @@ PLANNER_PROGRAMS = {
     "G2 X5.2713 Y-4.7131 I0.2791 J-4.9922\nG1 Y-14.7131\nM2\n",
     "arc_kink_last": "G21 G90 G64 P0.0254 Q0\nG0 Y-5 Z5\nG1 F12000\nG19 G3 Y0 Z0 J5 K0\n"
     "G1 Y9.9452 Z1.0453\nM2\n",
+    # arcs outside XY: a slow G18 half circle as the last move (a / 4 on it), a G18 half
+    # circle of 100 mm between lines under G61 (its acceleration split at Z's 100 mm/s, and a
+    # reversal after it that sets no kink), a G19 helical turn between lines (its parabolic
+    # blends on the planar tangent)
+    "g18_half_last": "G21 G90 G64 P0.01\nG18 G1 X10 F1200\nG2 X30 Z0 I10 K0\nM2\n",
+    "g18_r100_g61": "G21 G90 G61\nG18 G1 X10 F3000\nG2 X210 Z0 I100 K0\nG1 Z-10\nM2\n",
+    "g19_helix": "G21 G90 G64 P0.01\nG19 G1 Y10 F3000\nG3 Y10 Z0 X20 J5 K0\nG1 Z-10\nM2\n",
+    # a change of path-control mode: the junction takes the mode of the move before it
+    "g61_then_g64": "G21 G90 G61\nG1 X20 F3000\nG64 P0.05\nG1 Y20\nG1 X0\nM2\n",
+    "g64_then_g61": "G21 G90 G64 P0.05\nG1 X20 F3000\nG61\nG1 Y20\nG1 X0\nM2\n",
     "g61_stops": "G21 G90 G61\nG1 F1800\n"
     + "".join(
         f"X{20 * math.sin(k / 20):.4f} Y{20 - 20 * math.cos(k / 20):.4f}\n" for k in range(1, 11)

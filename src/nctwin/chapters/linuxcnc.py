@@ -217,16 +217,19 @@ def path_control(tp: Toolpath, profile: Profile) -> str:
 #: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
 #: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
 #: before the CAM-style recordings showed the rules for kinks and arcs missing, before stops
-#: were put on whole servo periods, and with the near-reversal threshold it had then measured.
+#: were put on whole servo periods and programmed arcs split their acceleration at their speed
+#: limit, and with the near-reversal threshold it had then measured.
 PLANNER_RULES = {
     "all": {},
     "no arc blends": {"arc_blends": False},
     "no kinks": {"kinks": False},
     "largest arcs": {"sized_arcs": False},
     "stops off periods": {"stop_periods": "off"},
+    "arcs at their feed": {"arc_rules": False},
     "as first written": {
         "kinks": False,
         "sized_arcs": False,
+        "arc_rules": False,
         "stop_periods": "off",
         "stop_turn_rad": 0.02,
     },
@@ -237,8 +240,8 @@ def planner_ablation(
     programs: dict[str, tuple[str, Toolpath, float]], profile: Profile
 ) -> pd.DataFrame:
     """The blend-arc planner with and without its rules for blends at programmed arcs, for
-    nearly tangent junctions, for the size of blend arcs and for stops on whole servo periods
-    (:data:`PLANNER_RULES`).
+    nearly tangent junctions, for the size of blend arcs, for stops on whole servo periods and
+    for programmed arcs' acceleration (:data:`PLANNER_RULES`).
 
     The planner learns nothing from recordings, so for it the training sets are held-out
     programs: a check of its rules on programs that were not used to find them.
@@ -370,7 +373,7 @@ def _value(row: pd.Series | None, column: str):
 #: The sets of every program LinuxCNC runs that is not one of nctwin's training or test sets.
 EVERY_PROGRAM_SETS = ("public", "language")
 #: The experiment's design: recordings per set (the recording's name up to its first ``_``).
-DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 5, "public": 14}
+DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 6, "public": 14}
 #: The claims on the public programs, which need every program's path-control mode known
 #: (condition ``startup_mode_programs`` of :func:`experiment_conditions`).
 PUBLIC_CLAIMS = ("best_median_public", "best_worst_public", "best_beats_cam_public",

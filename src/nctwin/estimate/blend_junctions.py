@@ -41,7 +41,8 @@ stated here as facts:
    every item).
 6. **The best of three** (``tpChooseBestBlend``): the blend arc is kept only if its speed
    limit beats both the kink speed :math:`v_k` and half the parabolic blend's net speed
-   (``estimateParabolicBlendPerformance``, :func:`parabolic_performance`); where the arc
+   (``estimateParabolicBlendPerformance``, :func:`parabolic_performance`, its angle between
+   the directions of :func:`parabolic_directions`, not the tangents); where the arc
    fails, the better of the other two is taken. A tangent pass runs both moves at
    :math:`1 - r_k` of their acceleration; a parabolic blend at half
    (``tcGetOverallMaxAccel``).
@@ -69,6 +70,7 @@ __all__ = [
     "arc_junctions",
     "blend_plane_acc",
     "choose_blends",
+    "parabolic_directions",
     "parabolic_performance",
 ]
 
@@ -330,6 +332,51 @@ def arc_junction_blends(
     }
 
 
+def parabolic_directions(
+    moves: Toolpath,
+    overall_acc_mm_s2: np.ndarray,
+    req_speed_mm_s: np.ndarray,
+    arc_rules: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    r"""Directions at the end and at the start of M moves whose angle sets a parabolic blend's
+    speed (``tpComputeBlendVelocity``: ``tcGetEndAccelUnitVector``,
+    ``tcGetStartAccelUnitVector``), shapes (M, 3).
+
+    A line's is its direction. An arc's is not its tangent: at its end the tangent of its
+    plane, :math:`n \times (p_{end} - c)` (``tcCircleEndAccelUnitVector``: a helix's rise
+    left out); at its start the tangent of its plane scaled by the arc's overall acceleration
+    :math:`a` (``tcGetOverallMaxAccel``) plus the unit vector to the centre scaled by
+    :math:`(F/2)^2 / r` with the requested feed :math:`F` (``tcCircleStartAccelUnitVector``),
+    normalised. A line into a helix that rises along it, or a helix that ends running along
+    the next line within its plane, is so blended nearly straight on.
+
+    Parameters
+    ----------
+    moves : Toolpath
+        M moves of non-zero length.
+    overall_acc_mm_s2, req_speed_mm_s : ndarray, shape (M,)
+        Each move's overall acceleration and requested feed (used on arcs only).
+    arc_rules : bool
+        False: the tangents, arcs' too (the planner's ablation).
+    """
+    end, start = moves.end_tangents.copy(), moves.start_tangents.copy()
+    arc = np.flatnonzero(moves.is_arc)
+    if not (len(arc) and arc_rules):
+        return end, start
+    rows = np.arange(len(arc))
+    normal_axis = moves._plane_axes[arc, 2]
+    planar_end, planar_start = end[arc], start[arc]
+    planar_end[rows, normal_axis] = 0.0
+    planar_start[rows, normal_axis] = 0.0
+    inward = moves.center_mm[arc] - moves.start_mm[arc]
+    inward[rows, normal_axis] = 0.0
+    normal_acc = (0.5 * req_speed_mm_s[arc]) ** 2 / moves.radius_mm[arc]
+    start_acc = _unit(planar_start) * overall_acc_mm_s2[arc, None]
+    end[arc] = _unit(planar_end)
+    start[arc] = _unit(start_acc + _unit(inward) * normal_acc[:, None])
+    return end, start
+
+
 def parabolic_performance(
     length1: np.ndarray,
     length2: np.ndarray,
@@ -390,6 +437,7 @@ def arc_junctions(
     moves: Toolpath,
     candidates: np.ndarray,
     speed_mm_s: np.ndarray,
+    req_speed_mm_s: np.ndarray,
     path_acc_mm_s2: np.ndarray,
     tol_mm: np.ndarray,
     kink_share: np.ndarray,
@@ -397,6 +445,7 @@ def arc_junctions(
     axis_acc_mm_s2: np.ndarray,
     axis_vel_mm_s: np.ndarray,
     period_s: float,
+    arc_rules: bool = True,
 ) -> dict[str, np.ndarray]:
     r"""What LinuxCNC makes of the junctions of M moves marked ``candidates`` (rules 1-6 of the
     module docstring), shapes (M - 1,).
@@ -411,6 +460,8 @@ def arc_junctions(
     speed_mm_s : ndarray, shape (M,)
         Speed limit of each move as queued (``tcGetMaxTargetVel``: its feed within its limits
         and its length per servo period).
+    req_speed_mm_s : ndarray, shape (M,)
+        Requested feed of each move (``reqvel``: the feed within canon's limits).
     path_acc_mm_s2 : ndarray, shape (M,)
         The acceleration the axes allow along each move (``maxaccel``).
     tol_mm : ndarray, shape (M - 1,)
@@ -422,6 +473,8 @@ def arc_junctions(
         rest).
     axis_acc_mm_s2, axis_vel_mm_s : ndarray, shape (3,)
     period_s : float
+    arc_rules : bool
+        The parabolic blend's directions (:func:`parabolic_directions`).
 
     Returns
     -------
@@ -484,9 +537,12 @@ def arc_junctions(
     scale = 0.5 * (1.0 - KINK_RATIO)
     acc1 = path_acc_mm_s2[j] * scale * np.where(arc[j], 0.5, 1.0)
     acc2 = path_acc_mm_s2[j + 1] * scale * np.where(arc[j + 1], 0.5, 1.0)
+    # the angle of the parabolic blend from its own directions, the next move at its
+    # overall acceleration then (its parabolic end and the kink)
+    d_end, d_start = parabolic_directions(moves, path_acc_mm_s2 * scale, req_speed_mm_s, arc_rules)
     parabolic = parabolic_performance(
         length[j], length[j + 1], speed_mm_s[j], speed_mm_s[j + 1], acc1, acc2,
-        np.einsum("ij,ij->i", u1, u2), tol_mm[j],
+        np.einsum("ij,ij->i", d_end[j], d_start[j + 1]), tol_mm[j],
     )  # fmt: skip
     out["choice"][j] = choose_blends(np.where(blend["made"], arc_speed, 0.0), kink_speed, parabolic)
     out["kink_speed"][j] = kink_speed

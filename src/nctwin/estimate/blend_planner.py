@@ -12,7 +12,9 @@ test programs (below).
 **What the planner receives.** LinuxCNC's canon first merges chains of straight feed moves that
 lie within the naive-CAM tolerance ``G64 Q`` of one line (:func:`nctwin.naivecam.merge_naive_cam`).
 The moves are the lines, rapids and arcs (whole) of non-zero length; feed and tangential
-acceleration per move come from :func:`move_limits` (an arc keeps within its centripetal limit).
+acceleration per move come from :func:`move_limits`: an arc keeps within the centripetal limit
+of its plane's axes (in ``G18`` X and Z, in ``G19`` Y and Z: Z's 500 mm/s² on ``linuxcnc_sim``),
+and splits its acceleration between tangent and normal at its speed limit, not at its feed.
 
 **Junction** :math:`j` between moves of length :math:`L_1, L_2`, the first ending along the unit
 tangent :math:`u_1`, the second starting along :math:`u_2`:
@@ -20,7 +22,11 @@ tangent :math:`u_1`, the second starting along :math:`u_2`:
 * the half supplement of the turn, :math:`\theta = \arccos(-u_1 \cdot u_2) / 2`
   (:math:`\pi/2` straight on, 0 for a reversal);
 * the tolerance :math:`T = \min(P, r L_1, r L_2)` with :math:`r = 1/4`, where :math:`P` is the
-  ``G64 P`` in force and a plain ``G64`` (no tolerance) means :math:`P = r L` of the move;
+  smaller ``G64 P`` of the two moves and a plain ``G64`` (no tolerance) means :math:`P = r L` of
+  the move (``tcFindBlendTolerance``); the junction blends, stops or passes exactly as the mode
+  of the move before it says (``tcSetupState``: a move keeps the mode in force when it is
+  queued; checked live, ``G61`` then ``G64 P0.05`` round two corners 1.397 s (1.397), the other
+  way round 1.356 s (1.356; 15 and 6 ms off with the mode of the move after));
 * the largest distance from the corner along the moves the tolerance allows,
   :math:`d_{tol} = \cos\theta \, T / (1 - \sin\theta)`, and at most half of each move,
   :math:`d_g = \min(d_{tol}, L_1/2, L_2/2)`, the largest radius :math:`R_g = d_g \tan\theta`;
@@ -41,8 +47,9 @@ tangent :math:`u_1`, the second starting along :math:`u_2`:
   in ``G64`` and in ``G61`` alike;
 * ``G61`` stops at every other junction, with both moves at :math:`1 -` :data:`KINK_RATIO` of
   their acceleration (``tcSetKinkProperties``); ``G61.1``, a dwell, a change between rapid and
-  feed motion (``tpCheckCanonType``) and the program's ends stop the tool (:math:`v_j = 0`) at
-  the full acceleration, and so does a turn within 2° of a reversal (:math:`2\theta` below
+  feed motion (``tpCheckCanonType``, ``handleModeChange``; in ``G61`` too) and the program's
+  ends stop the tool (:math:`v_j = 0`) at the full acceleration, and so does a turn within 2°
+  of a reversal (:math:`2\theta` below
   :data:`STOP_TURN_RAD`, ``tpSetupTangent``'s sharp corner): measured on LinuxCNC, 13.7 mm and
   33.3 mm moves at 12.9 mm/s on a plain ``G64`` stop at turns of :math:`\pi` - 0.015 to
   :math:`\pi` - 0.032 rad (4.468 s with a 10 mm move after them) and are blended from
@@ -99,7 +106,7 @@ Not modelled: the parabolic blends LinuxCNC falls back to between two lines wher
 (``tpChooseBestBlend`` is applied at junctions with an arc only), a line consumed by a blend
 into the last move (LinuxCNC compares with the blend's planned speed; here with the junction's
 speed, which is lower into a short last move), the time LinuxCNC's task takes around a dwell
-(2-4 ms), and helical arcs' effective radius. The rules for junctions with an arc
+(2-4 ms). The rules for junctions with an arc
 (:mod:`~nctwin.estimate.blend_junctions`) came from the public programs ``blur_torus`` and
 ``LHchips4`` (-2.7 and -2.1 % before them, +0.07 and -0.48 % with them), each read in
 LinuxCNC's source and checked live on 70 short programs of an arc, a line of 0.126 or 1 mm
@@ -122,11 +129,24 @@ servo period per stop: the tool comes to rest on a whole servo period (:func:`st
 at 60 mm/s: 3.594 s (3.594; 3.541 as trapezoids); circles of 5 mm radius in 20, 100 and 400
 chords at 50 mm/s: 1.580, 3.592 and 7.272 s (1.580, 3.592 and 7.272; 1.573, 3.540 and 7.082 as
 trapezoids); under ``G61.1``, the 0.3 mm chords on a 500 mm radius: 3.500 s (3.500; 3.463).
+
+Arcs outside the XY plane (``G18``, ``G19``) and helices: :func:`move_limits` (canon's
+``ARC_FEED``, ``tcUpdateCircleAccRatio``, ``pmCircleActualMaxVel``,
+``pmCircleEffectiveMinRadius``) and the directions of parabolic blends at arcs
+(:func:`~nctwin.estimate.blend_junctions.parabolic_directions`). Checked live: half circles of
+10 mm radius at 20 mm/s in XY, XZ and YZ as the last move, 1.651, 1.731 and 1.731 s (1.651, 1.731,
+1.731; before these rules 1.611, 1.652, 1.652); half circles of 5, 40 and 100 mm radius between
+lines, in XY and XZ, under ``G61`` and ``G64 P0.01``: all twelve within 1 ms (before: up to
+-2.0 %); a ``G18`` helix of 10 mm radius and a ``G19`` helical turn of 5 mm radius between lines:
+2.264 and 1.407 s under ``G61`` (2.264, 1.407; before 2.264, 1.524), 2.397 and 1.431 s under
+``G64 P0.01`` (2.392, 1.428; before 2.349, 1.922); LinuxCNC's sample ``3dtest.ngc``, a circle in
+each plane: 51.345 s (51.345; before 51.282).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -144,6 +164,7 @@ from .blend_junctions import (
     TANGENT_BLEND,
     arc_junctions,
     blend_plane_acc,
+    parabolic_directions,
 )
 from .blend_speeds import optimised_end_speeds, segment_times, stops_on_periods
 from .result import Estimate
@@ -175,19 +196,45 @@ STOP_PERIODS = ("whole", "mean", "off")
 
 
 def move_limits(
-    moves: Toolpath, machine: Machine, acc_scale: np.ndarray | None = None
+    moves: Toolpath,
+    machine: Machine,
+    acc_scale: np.ndarray | None = None,
+    *,
+    finalized: np.ndarray | None = None,
+    arc_ratio: str = "max_speed",
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Feed and tangential acceleration of each move as LinuxCNC plans it, shapes (M,).
 
     Lines and rapids: the feed (the rapid feed for rapids) within the control's maximum and
     the axes' velocities, :math:`\min_i v_{i,\max} / |u_i|`, and the path acceleration the
-    axes allow, :math:`\min_i a_{i,\max} / |u_i|` (canon's ``getStraightAcceleration``;
-    :func:`nctwin.limits.path_limits`, whose rule for arcs is LinuxCNC's: the plane's two axes
-    take the planar share of the length and the third the helical share); on arcs then the
-    centripetal limit of ``pmCircleActualMaxVel``: the speed
-    stays within :math:`\sqrt{a_n r}` with :math:`a_n` = :data:`NORMAL_ACC_RATIO` :math:`a`,
-    and the tangential acceleration is :math:`a/2` where that limit binds, else
-    :math:`a \sqrt{1 - (F^2 / (r a))^2}`.
+    axes allow, :math:`a = \min_i a_{i,\max} / |u_i|` (canon's ``getStraightVelocity``,
+    ``getStraightAcceleration``; :func:`nctwin.limits.path_limits`, whose rule for arcs is
+    LinuxCNC's: the plane's two axes take the planar share :math:`r\phi/l` of the length and the
+    third the helical share :math:`h/l`).
+
+    Arcs (``arc_ratio="max_speed"``, LinuxCNC's rule), in three steps:
+
+    * canon's ``ARC_FEED`` gives the arc the speed limit
+      :math:`v_{\max} = \min(v_a, \sqrt{a_n a_p r}\; l / (r\phi))` with :math:`v_a` the
+      axes' limit above and :math:`a_p` the smaller acceleration of the plane's two axes (X and
+      Z in ``G18``, Y and Z in ``G19``), :math:`a_n` = :data:`NORMAL_ACC_RATIO`;
+    * when the next move is queued the arc is finalized (``tcFinalizeLength``,
+      ``tcUpdateCircleAccRatio``, ``pmCircleActualMaxVel``): with its overall acceleration
+      :math:`a' = a s` (``tcGetOverallMaxAccel``: ``acc_scale`` :math:`s`) and its effective
+      radius :math:`r_e = r + h^2/r` (``pmCircleEffectiveMinRadius``, with the whole rise
+      :math:`h`), the normal acceleration at *the speed limit*, not at the feed,
+      :math:`a_v = v_{\max}^2 / r_e`, decides: above :math:`a_n a'` the limit drops to
+      :math:`\sqrt{a_n a' r_e}` and the tangential acceleration is :math:`a'/2`, else it is
+      :math:`a' \sqrt{1 - (a_v / a')^2}`: a slow arc of small radius accelerates at
+      :math:`a'/2` as a fast one does;
+    * an arc never finalized (the program's last move, a move before a dwell; ``finalized``
+      False) keeps the tangential acceleration :math:`a'/2` it was queued with (``tcInit``).
+
+    The feed is the programmed one within :math:`v_{\max}`.
+    ``arc_ratio="feed"`` is the rule as first written, from the programmed feed
+    :math:`F` instead: a speed within :math:`\sqrt{a_n a' r}` and the tangential acceleration
+    :math:`a' \sqrt{1 - (F^2 / (r a'))^2}` (:math:`a'/2` where that limit binds); the learned
+    methods' features keep it (:mod:`nctwin.estimate.learned`).
 
     Parameters
     ----------
@@ -197,7 +244,13 @@ def move_limits(
     acc_scale : ndarray, shape (M,), optional
         Share of the acceleration each move may use (LinuxCNC halves it on both moves of a
         parabolic blend, ``tcGetOverallMaxAccel``); 1 by default.
+    finalized : ndarray of bool, shape (M,), optional
+        The move is finalized (all but the last by default).
+    arc_ratio : {"max_speed", "feed"}
+        The rule for arcs (above).
     """
+    if arc_ratio not in ("max_speed", "feed"):
+        raise ValueError(f"arc_ratio = {arc_ratio!r} is not allowed: allowed max_speed, feed")
     limits = path_limits(moves, machine)
     v_axes, acc = limits.velocity_mm_s, limits.acceleration_mm_s2
     if acc_scale is not None:
@@ -206,13 +259,34 @@ def move_limits(
     feed = np.where(rapid, machine.rapid_feed_mm_s, moves.feed_mm_s)
     feed = np.minimum(np.minimum(feed, machine.max_feed_mm_s), v_axes)
     arc = np.flatnonzero(moves.is_arc)
-    if len(arc):
-        r, a, f = moves.radius_mm[arc], acc[arc], feed[arc]
+    if not len(arc):
+        return feed, acc
+    r, a, f = moves.radius_mm[arc], acc[arc], feed[arc]
+    if arc_ratio == "feed":
         a_normal = f**2 / r
         cut = a_normal > NORMAL_ACC_RATIO * a
         feed[arc] = np.where(cut, np.sqrt(NORMAL_ACC_RATIO * a * r), f)
         ratio = np.sqrt(np.maximum(1.0 - (a_normal / a) ** 2, 0.0))
         acc[arc] = a * np.where(cut, TANGENTIAL_ACC_RATIO, ratio)
+        return feed, acc
+    if finalized is None:
+        finalized = np.arange(len(moves)) < len(moves) - 1
+    ax = moves._plane_axes[arc]
+    axis_acc = np.asarray(machine.axis_max_acceleration_mm_s2)
+    plane_acc = np.minimum(axis_acc[ax[:, 0]], axis_acc[ax[:, 1]])
+    length = moves.lengths_mm[arc]
+    planar = r * np.abs(moves.sweep_rad[arc])
+    v_max = np.minimum(v_axes[arc], np.sqrt(NORMAL_ACC_RATIO * plane_acc * r) * length / planar)
+    rise_sq = np.maximum(length**2 - planar**2, 0.0)
+    r_eff = r + rise_sq / r
+    a_v = v_max**2 / r_eff
+    done = finalized[arc]
+    cut = done & (a_v > NORMAL_ACC_RATIO * a)
+    v_max = np.where(cut, np.sqrt(NORMAL_ACC_RATIO * a * r_eff), v_max)
+    ratio = np.sqrt(np.maximum(1.0 - (a_v / a) ** 2, 0.0))
+    ratio = np.where(cut | ~done, TANGENTIAL_ACC_RATIO, ratio)
+    feed[arc] = np.minimum(f, v_max)
+    acc[arc] = a * ratio
     return feed, acc
 
 
@@ -408,6 +482,7 @@ def blend_planner(
     kinks: bool = True,
     sized_arcs: bool = True,
     arc_blends: bool = True,
+    arc_rules: bool = True,
     stop_periods: str = "whole",
     stop_turn_rad: float = STOP_TURN_RAD,
 ) -> Estimate:
@@ -429,6 +504,11 @@ def blend_planner(
         LinuxCNC's blend arcs at junctions with a programmed arc, and what replaces them where
         they fail or are slower (:func:`~nctwin.estimate.blend_junctions.arc_junctions`); on by
         default (needs ``kinks``), off for the ablation: the line-line formula on the tangents.
+    arc_rules : bool
+        LinuxCNC's rules for programmed arcs: the tangential acceleration from the arc's speed
+        limit (:func:`move_limits`) and the directions of parabolic blends at arcs
+        (:func:`~nctwin.estimate.blend_junctions.parabolic_directions`); on by default, off
+        for the ablation: the acceleration from the feed and the blends on the tangents.
     stop_periods : {"whole", "mean", "off"}
         ``whole``: the tool comes to rest on a servo period (:func:`stops_on_periods`), as on
         LinuxCNC; ``mean``: each stop adds half a period instead, the mean of the same on
@@ -454,14 +534,23 @@ def blend_planner(
         return Estimate("planner", machine.name, toolpath.dwell_s.copy(), toolpath)
     moves = merged.take(source)
     length = moves.lengths_mm
-    feed, acc = move_limits(moves, machine)
-    tol = moves.effective_tolerance_mm(control.blend_tol_mm)
-    # a dwell between two moves stops the tool; the move before it keeps its parabolic end
+    own = moves.effective_tolerance_mm(control.blend_tol_mm)
+    # the junction after a move: that move's mode (tcSetupState, the term condition in force
+    # when it was queued) and the smaller of the two moves' tolerances (tcFindBlendTolerance)
+    given = np.where(np.isfinite(own) & (own > 0), own, np.inf)
+    tol = own.copy()
+    tol[1:] = np.where(own[:-1] == 0, 0.0, np.minimum(given[:-1], given[1:]))
+    # a dwell between two moves stops the tool; the move before it keeps its parabolic end,
+    # and, like the last move, is never finalized (an arc keeps a / 2, move_limits)
     after = np.searchsorted(source, np.flatnonzero(merged.kind == MotionKind.DWELL))
     parabolic_end = np.zeros(len(moves), bool)
     parabolic_end[after[(after > 0) & (after <= len(moves))] - 1] = True
     parabolic_end[-1] = True
-    parabolic_end &= tol > 0
+    limits = functools.partial(
+        move_limits, finalized=~parabolic_end, arc_ratio="max_speed" if arc_rules else "feed"
+    )
+    feed, acc = limits(moves, machine)
+    parabolic_end &= own > 0
     tol[after[after < len(moves)]] = 0.0
     # LinuxCNC does not blend between a rapid and a feed move: the tool stops (tpCheckCanonType)
     rapid = moves.kind == MotionKind.RAPID
@@ -469,11 +558,17 @@ def blend_planner(
     axis_acc = np.asarray(machine.axis_max_acceleration_mm_s2)
     # nearly tangent junctions (but not into an exact stop): no blend arc, no stop, both moves
     # at 1 - k of their acceleration; the other G61 junctions stop with both moves at
-    # 1 - KINK_RATIO (tcSetKinkProperties, kept where no blend arc replaces the kink)
+    # 1 - KINK_RATIO (tcSetKinkProperties, kept where no blend arc replaces the kink); a change
+    # between rapid and feed stops in G61 too, before any kink is set (handleModeChange)
     stop = (tol[1:] == 0) & (moves.path_mode[:-1] != PathMode.EXACT_PATH)
+    stop |= rapid[1:] != rapid[:-1]
     tangent, kink = tangent_junctions(moves, feed, acc, axis_acc, control.period_s)
     tangent &= ~stop & kinks
-    exact = (tol[1:] == 0) & ~stop & ~tangent & kinks
+    # a turn within stop_turn_rad of a reversal stops the tool before any kink is set
+    # (tpSetupTangent's sharp corner): no reduced acceleration
+    dot = np.einsum("ij,ij->i", moves.end_tangents[:-1], moves.start_tangents[1:])
+    sharp = np.arccos(-np.clip(dot, -1.0, 1.0)) < stop_turn_rad
+    exact = (tol[1:] == 0) & ~stop & ~tangent & ~sharp & kinks
     # a junction with an arc: a blend arc as LinuxCNC makes it, if it beats a tangent pass at
     # the kink speed and a parabolic blend (blend_junctions); the tangent pass keeps both
     # moves at 1 - KINK_RATIO
@@ -489,9 +584,10 @@ def blend_planner(
             length, moves.end_tangents, moves.start_tangents, feed, tol, axis_acc,
             sized_arcs=sized_arcs, stop_turn_rad=stop_turn_rad,
         )[1]  # fmt: skip
+    req_speed = limits(moves, machine, finalized=np.zeros(len(moves), bool))[0]  # reqvel
     choice = arc_junctions(
-        moves, candidates, speed, path_acc, tol[1:], kink, line_trim, axis_acc, axis_vel,
-        control.period_s,
+        moves, candidates, speed, req_speed, path_acc, tol[1:], kink, line_trim, axis_acc,
+        axis_vel, control.period_s, arc_rules,
     )  # fmt: skip
     kinked = choice["choice"] == TANGENT_BLEND
     reduce = np.where(tangent, kink, np.where(exact | kinked, KINK_RATIO, 0.0))
@@ -499,7 +595,7 @@ def blend_planner(
     kept[:-1] = 1.0 - reduce
     kept[1:] = np.minimum(kept[1:], 1.0 - reduce)
     if (reduce > 0).any():
-        feed, acc = move_limits(moves, machine, kept)
+        feed, acc = limits(moves, machine, kept)
     v, d, arc, arc_acc = junction_blends(
         length,
         moves.end_tangents,
@@ -524,14 +620,14 @@ def blend_planner(
     halved[:-1] |= para
     halved[1:] |= para
     if para.any():
-        feed, acc = move_limits(moves, machine, kept * np.where(halved, TANGENTIAL_ACC_RATIO, 1.0))
+        share = kept * np.where(halved, TANGENTIAL_ACC_RATIO, 1.0)
+        feed, acc = limits(moves, machine, share)
+        u_end, u_start = parabolic_directions(moves, path_acc * share, req_speed, arc_rules)
         # each move as long as the blends at its other ends leave it (its target)
         d_end, d_start = (np.where(para, 0.0, x) for x in (d_end, d_start))
         target = length - np.concatenate([[0.0], d_start]) - np.concatenate([d_end, [0.0]])
         target = np.maximum(target, 1e-9)
-        speed = parabolic_blend_speeds(
-            target, feed, acc, moves.end_tangents, moves.start_tangents, tol
-        )
+        speed = parabolic_blend_speeds(target, feed, acc, u_end, u_start, tol)
         v = np.where(para, speed, v)
     v = np.where(tangent, np.minimum(feed[:-1], feed[1:]), v)
     d_end, d_start, arc = (np.where(tangent | para, 0.0, x) for x in (d_end, d_start, arc))
@@ -568,7 +664,7 @@ def blend_planner(
     # the look-ahead plans with the speed limits of the machine, not the programmed feed
     item_max = np.empty(2 * m - 1)
     unfed = dataclasses.replace(moves, feed_mm_s=np.full(m, np.inf))
-    item_max[0::2] = move_limits(unfed, machine)[0]
+    item_max[0::2] = limits(unfed, machine)[0]
     item_max[1::2] = v
     blended = limit > 0
     blended[-1] = False

@@ -149,7 +149,7 @@ def features(moves: Toolpath, machine: Machine, control: PlannerControl) -> np.n
     along the move (:func:`nctwin.limits.path_limits`) and the naive-CAM tolerance. The tool
     starts and ends at rest (corner angle :math:`\pi`).
     """
-    feed, acc = move_limits(moves, machine)
+    feed, acc = move_limits(moves, machine, arc_ratio="feed")
     n = len(moves)
     theta = np.append(moves.corner_angles_rad, np.pi)
     if n:

@@ -1,6 +1,6 @@
 r"""Part programs in the whole RS274/NGC language, as a shop's CAM system or a programmer at the
 machine writes them: canned drilling cycles, cutter compensation, subroutines, parameters and
-expressions, offsets and units.
+expressions, offsets and units, arcs and helices outside the XY plane.
 
 Paper 1's training programs and the CAM-style programs (:mod:`nctwin.programs.training`,
 :mod:`nctwin.programs.camstyle`) are chains of G1 lines that the native reader reads. A shop's
@@ -277,6 +277,68 @@ M2
 """
 
 
+def plane_arcs() -> str:
+    """Arcs and helices in the ZX (G18) and YZ (G19) planes, where Z's lower limits (100 mm/s,
+    500 mm/s^2 on ``linuxcnc_sim``) bound the arc: half, quarter and full circles of 2-40 mm
+    radius at 10-100 mm/s, joined to lines at right angles, tangentially, by a reversal and to
+    each other; a helical half turn in each plane and a full helical turn; a dwell after an
+    arc, and an arc as the last move."""
+    return """\
+(nctwin language program: arcs and helices in the ZX and YZ planes)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+G0 X0 Y0 Z0
+(G18: half circles of 10 mm at two feeds between lines, at right angles)
+G18 G1 X10 F1200
+G2 X30 Z0 I10 K0
+G1 X40
+G3 X60 Z0 I10 K0 F6000
+(a tangent S of two half circles of 5 mm)
+G2 X70 Z0 I5 K0 F3000
+G1 X80
+(quarter circles of 25 and 40 mm, a tangent line between and after)
+G3 X105 Z25 I25 K0
+G1 X115
+G2 X155 Z65 I0 K40 F1800
+G1 Z80
+(a helical half turn of 10 mm down 10 mm in Y, then full circles of 5 and 2 mm)
+G2 X175 Z80 Y-10 I10 K0 F1200
+G1 X185 F2000
+G2 X185 Z80 I5 K0 F3000
+G3 X185 Z80 I2 K0 F600
+G0 X200 Y0 Z0
+(G19: the same in the YZ plane)
+G19 G1 Y10 F1200
+G2 Y30 Z0 J10 K0
+G1 Y40
+G3 Y60 Z0 J10 K0 F6000
+G2 Y70 Z0 J5 K0 F3000
+G1 Y80
+G2 Y105 Z25 J25 K0
+G1 Y115
+G3 Y155 Z65 J0 K40 F1800
+G1 Z80
+G3 Y175 Z80 X210 J10 K0 F1500
+G1 Y185 F2000
+(a full helical turn of 5 mm back 5 mm in X)
+G2 Y185 Z80 X205 J5 K0 F3000
+(a plunge, a half circle of 5 mm and a line between rapids, then a wider tolerance)
+G0 Z85
+G1 Z80 F1200
+G2 Y195 Z80 J5 K0
+G1 Y205
+G0 Z85
+G64 P0.05
+(a dwell after a G18 half circle, and a G18 arc to end the program)
+G1 Z80 F2400
+G18 G2 X225 Z80 I10 K0
+G4 P0.3
+G1 X235
+G3 X255 Z80 I10 K0 F1800
+M2
+"""
+
+
 #: Name -> function returning the program's text.
 LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "drill_cycles": drill_cycles,
@@ -284,4 +346,5 @@ LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "subroutines": subroutines,
     "parametric_curve": parametric_curve,
     "offsets_units": offsets_units,
+    "plane_arcs": plane_arcs,
 }
