@@ -138,6 +138,15 @@ def test_exact_stop_and_dwell():
     assert targets.cycle_time_s == pytest.approx(motion.cycle_time_s)
 
 
+def test_exact_stop_arc_runs_at_its_feed():
+    # G61 stops at every block end; along the arc the filter's shrinkage keeps to the control's
+    # tolerance (not 0). Half circle r 5 at 40 mm/s between two 10 mm lines, each block from rest
+    # to rest: sum(L / F) + 3 (T1 + T2). Shrink limit sqrt(2 r tol / var) = 47 mm/s > 40.
+    motion = fir.run(parse("G61 G1 X10 F2400\nG2 X20 Y0 I5 J0\nG1 X30"), MACHINE, SETTINGS)
+    expected = (20.0 + math.pi * 5.0) / 40.0 + 3 * (SETTINGS.t1_s + SETTINGS.t2_s)
+    assert motion.cycle_time_s == pytest.approx(expected, abs=3 * PERIOD_S)
+
+
 def test_short_segments_on_a_circle_keep_the_feed_high():
     # 1000 segments of 0.1 mm on a circle of radius 20 mm: blended globally
     r, n, feed = 20.0, 1000, 80.0

@@ -188,7 +188,8 @@ def _block_feeds(
     """Cruise feed of each block (mm/s), shape (N,): the programmed feed ``feed_mm_s`` (N,)
     within every limit (:func:`nctwin.limits.path_limits` of the axes' velocities and of the
     velocity steps the filters make of their accelerations and jerks; on arcs, the centripetal
-    acceleration and the filter's radial shrinkage within the tolerance ``tol_mm`` (N,))."""
+    acceleration and the filter's radial shrinkage within the tolerance ``tol_mm`` (N,): the
+    program's, or on an exact-stop arc the control's, since exact stop acts at a block's ends))."""
     kind = tp.kind
     f = np.where(
         kind == MotionKind.RAPID,
@@ -274,7 +275,8 @@ def plan(
     machine = enforced_machine(machine, control)
     fir = FirFilter.of(control)
     feed_mm_s, tol = stand_in(tp, control)
-    feed = _block_feeds(tp, machine, fir, feed_mm_s, tol)
+    contour_tol = np.where(tol > 0, tol, control.blend_tol_mm)
+    feed = _block_feeds(tp, machine, fir, feed_mm_s, contour_tol)
     v = np.zeros(n + 1)
     pause = np.zeros(n + 1)
     if n == 0:
