@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from nctwin import parse
 from nctwin.controls import FirControl
-from nctwin.kernel import fir
+from nctwin.kernel import _fir_command, fir
 from nctwin.machine import Machine
 from nctwin.targets import block_targets
 
@@ -86,7 +86,7 @@ def test_unique_with_index_equals_unique_and_searchsorted(seed, n):
     rng = np.random.default_rng(seed)
     x = np.round(rng.uniform(0, 50, n), int(rng.integers(0, 3)))  # repeated values
     x[: n // 2].sort()  # a sorted run, as the command's block starts
-    cuts, index = fir._unique_with_index(x)
+    cuts, index = _fir_command._unique_with_index(x)
     np.testing.assert_array_equal(cuts, np.unique(x))
     np.testing.assert_array_equal(index, np.searchsorted(cuts, x))
 
@@ -145,6 +145,27 @@ def test_exact_stop_arc_runs_at_its_feed():
     motion = fir.run(parse("G61 G1 X10 F2400\nG2 X20 Y0 I5 J0\nG1 X30"), MACHINE, SETTINGS)
     expected = (20.0 + math.pi * 5.0) / 40.0 + 3 * (SETTINGS.t1_s + SETTINGS.t2_s)
     assert motion.cycle_time_s == pytest.approx(expected, abs=3 * PERIOD_S)
+
+
+RAMP_MACHINE = dataclasses.replace(MACHINE, axis_max_acceleration_mm_s2=(2000.0, 2000.0, 2000.0))
+
+
+def test_rapid_capped_at_the_filters_step_unless_ramped():
+    # the step the filters allow: A T1 = 2000 * 0.05 = 100 mm/s; capped, 300 mm take 3 s + T1 + T2
+    capped = fir.run(parse("G0 X300"), RAMP_MACHINE, SETTINGS)
+    assert capped.cycle_time_s == pytest.approx(3.0 + 0.06, abs=PERIOD_S)
+    # ramped: stairs of 100 mm/s, each held one box (T1 + Ts = 51 ms): up 100-400 and down over
+    # 2 * 1000 mm/s * 0.051 s = 102 mm, 198 mm at G0's 500 mm/s; 8 stairs + 0.396 s + T1 + T2
+    ramped = fir.run(parse("G0 X300"), RAMP_MACHINE, dataclasses.replace(SETTINGS, rapid_ramp=True))
+    assert ramped.cycle_time_s == pytest.approx(8 * 0.051 + 198 / 500 + 0.06, abs=PERIOD_S)
+    assert ramped.speed_mm_s.max() == pytest.approx(500.0)
+    acc = np.abs(np.diff(ramped.speed_mm_s)) / PERIOD_S
+    assert acc.max() <= 2000.0
+    # a short rapid never reaches G0: 100 mm/s for 5.1 mm at both ends, 200 mm/s between
+    short = fir.run(parse("G0 X20"), RAMP_MACHINE, dataclasses.replace(SETTINGS, rapid_ramp=True))
+    assert short.cycle_time_s == pytest.approx(2 * 0.051 + 9.8 / 200 + 0.06, abs=PERIOD_S)
+    with pytest.raises(ValueError, match="rapid_ramp = 1 is out of range"):
+        dataclasses.replace(SETTINGS, rapid_ramp=1)
 
 
 def test_short_segments_on_a_circle_keep_the_feed_high():

@@ -73,6 +73,10 @@ class FirControl:
     block_periods : int
         Shortest time of a move, in periods (a control's block-processing rate): a cutting move
         of length ``l`` runs at most at ``l / (n period_s)``; in [0, 100], 0: no limit.
+    rapid_ramp : bool
+        Rapids climb to the rapid feed in steps the filters ramp at the axes' acceleration
+        (:mod:`nctwin.kernel.fir_rapids`); False: every feed, rapids too, is capped at the
+        largest step the filters allow.
     """
 
     period_s: float = 0.001
@@ -82,6 +86,7 @@ class FirControl:
     acc_scale: float = 1.0
     blend_ratio: float = math.inf
     block_periods: int = 0
+    rapid_ramp: bool = False
 
     def __post_init__(self) -> None:
         _check_period(self.period_s)
@@ -92,6 +97,10 @@ class FirControl:
         if self.blend_ratio != math.inf:
             check_number("blend_ratio", self.blend_ratio, 0.0, 1.0, hi_closed=True,
                          allow_inf=True)  # fmt: skip
+        if not isinstance(self.rapid_ramp, bool):
+            raise ValueError(
+                f"rapid_ramp = {self.rapid_ramp!r} is out of range: allowed true, false"
+            )
         n = self.block_periods
         if not (isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 100):
             raise ValueError(f"block_periods = {n!r} is out of range: allowed integers in [0, 100]")

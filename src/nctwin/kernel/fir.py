@@ -51,7 +51,8 @@ from ..limits import path_limits
 from ..machine import Machine
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
-from . import _fir_loops
+from . import _fir_loops, fir_rapids
+from ._fir_command import Plan, _Command, _command
 
 __all__ = [
     "FirFilter",
@@ -163,27 +164,13 @@ def corner_deviation_mm(speed_mm_s, angle_rad, t1_s: float, t2_s: float):
     return speed_mm_s * np.sin(np.asarray(angle_rad) / 2) * (3 * t1**2 + t2**2) / (12 * t1)
 
 
-@dataclass(frozen=True)
-class Plan:
-    """What the look-ahead decided, per block and per junction.
-
-    Parameters
-    ----------
-    feed_mm_s : ndarray, shape (N,)
-        Cruise feed of each block after the machine's limits.
-    junction_mm_s : ndarray, shape (N + 1,)
-        Speed at the start of each block (index N: the end of the program); 0 is a stop.
-    pause_s : ndarray, shape (N + 1,)
-        Time the command waits at each junction (filter drain before a stop, dwells).
-    """
-
-    feed_mm_s: np.ndarray
-    junction_mm_s: np.ndarray
-    pause_s: np.ndarray
-
-
 def _block_feeds(
-    tp: Toolpath, machine: Machine, fir: FirFilter, feed_mm_s: np.ndarray, tol_mm: np.ndarray
+    tp: Toolpath,
+    machine: Machine,
+    fir: FirFilter,
+    feed_mm_s: np.ndarray,
+    tol_mm: np.ndarray,
+    ramp_rapids: bool = False,
 ) -> np.ndarray:
     """Cruise feed of each block (mm/s), shape (N,): the programmed feed ``feed_mm_s`` (N,)
     within every limit (:func:`nctwin.limits.path_limits` of the axes' velocities and of the
@@ -196,15 +183,12 @@ def _block_feeds(
         machine.rapid_feed_mm_s,
         np.minimum(np.nan_to_num(feed_mm_s, nan=np.inf), machine.max_feed_mm_s),
     )
-    vmax = np.asarray(machine.axis_max_velocity_mm_s)
-    amax = np.asarray(machine.axis_max_acceleration_mm_s2)
-    jmax = np.asarray(machine.axis_max_jerk_mm_s3)
     limits = path_limits(tp, machine)
     with np.errstate(divide="ignore"):
-        step = amax * fir.t1_s
-        if fir.t2_s > 0:
-            step = np.minimum(step, jmax * fir.t1_s * fir.t2_s)
-        f = np.minimum(f, limits.cap(np.minimum(vmax, step)))
+        step = fir_rapids.step_mm_s(machine, limits, fir.t1_s, fir.t2_s)
+        # a ramped rapid climbs to its feed in steps (fir_rapids); every other block is capped
+        step[(kind == MotionKind.RAPID) & ramp_rapids] = np.inf
+        f = np.minimum(f, np.minimum(limits.cap(machine.axis_max_velocity_mm_s), step))
         arc = tp.is_arc
         if arc.any():
             r = tp.radius_mm[arc]
@@ -276,7 +260,7 @@ def plan(
     fir = FirFilter.of(control)
     feed_mm_s, tol = stand_in(tp, control)
     contour_tol = np.where(tol > 0, tol, control.blend_tol_mm)
-    feed = _block_feeds(tp, machine, fir, feed_mm_s, contour_tol)
+    feed = _block_feeds(tp, machine, fir, feed_mm_s, contour_tol, control.rapid_ramp)
     v = np.zeros(n + 1)
     pause = np.zeros(n + 1)
     if n == 0:
@@ -341,79 +325,11 @@ def plan(
     drain = (v[:n] == 0) & np.concatenate([[False], ~dwell[:-1]])
     drain[0] = False
     pause[:n] = np.where(drain, fir.length_s, 0.0) + np.where(dwell, tp.dwell_s, 0.0)
-    return Plan(feed, v, pause)
-
-
-@dataclass(frozen=True)
-class _Command:
-    """Piecewise-constant speed command along the path.
-
-    ``cuts`` (C,) are arc lengths; interval ``i`` runs from ``cuts[i]`` to ``cuts[i+1]`` at
-    ``speed[i]`` inside block ``block[i]``; the command waits ``pause[c]`` at cut ``c``, in block
-    ``pause_block[c]``.
-    """
-
-    cuts: np.ndarray
-    speed: np.ndarray
-    block: np.ndarray
-    pause: np.ndarray
-    pause_block: np.ndarray
-
-    def knot_times(self, scale: np.ndarray | None = None) -> np.ndarray:
-        """Time knots (2C,) of the command, speeds multiplied by ``scale``: arrival at and
-        departure from each cut, whose arc length is :attr:`knot_s`."""
-        speed = self.speed if scale is None else self.speed * scale
-        knots = np.empty(2 * len(self.cuts))
-        _fir_loops.knot_times(self.cuts, speed, self.pause, knots)
-        return knots
-
-    @property
-    def knot_s(self) -> np.ndarray:
-        """Arc-length knots (2C,) of the command: each cut twice."""
-        return np.repeat(self.cuts, 2)
-
-
-def _unique_with_index(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct values of ``x`` (N,), sorted, as ``np.unique``, and the index of each
-    element among them (N,), as ``np.searchsorted`` would find it (no signed zeros or NaN).
-
-    A stable sort: it merges the sorted runs the command's arc lengths come in (block starts,
-    and the windows around them), where ``np.unique``'s quicksort sorts from scratch."""
-    order = np.argsort(x, kind="stable")
-    x = x[order]
-    new = np.empty(len(x), dtype=bool)
-    new[:1] = True
-    np.not_equal(x[1:], x[:-1], out=new[1:])
-    index = np.empty(len(x), dtype=np.intp)
-    index[order] = np.cumsum(new) - 1
-    return x[new], index
-
-
-def _command(tp: Toolpath, geo: PathGeometry, p: Plan, fir: FirFilter) -> _Command:
-    """The speed command: block feeds, lowered to each junction's speed over the filter window
-    centred on it, and the pauses."""
-    n = len(tp)
-    s_start = geo.s_start_mm
-    half = 0.5 * fir.length_s + 2 * fir.period_s  # the window, and a margin for sampling
-    v = p.junction_mm_s
-    zone = (v > 0) & np.isfinite(v)
-    z_lo = np.maximum(s_start[zone] - v[zone] * half, 0.0)
-    z_hi = np.minimum(s_start[zone] + v[zone] * half, geo.total_mm)
-    cuts, index = _unique_with_index(np.concatenate([s_start, z_lo, z_hi]))
-    at, i_lo, i_hi = np.split(index, [len(s_start), len(s_start) + len(z_lo)])
-    mid = 0.5 * (cuts[:-1] + cuts[1:])
-    block = geo.block_at_ordered(mid)
-    speed = p.feed_mm_s[block].copy()
-    if zone.any():
-        speed = np.minimum(speed, _fir_loops.range_min(len(mid), i_lo, i_hi, v[zone]))
-    pause = np.zeros(len(cuts))
-    np.add.at(pause, at, p.pause_s)
-    # a pause belongs to the dwell it is, else to the block that ends at the stop
-    pause_block = np.full(len(cuts), -1)
-    owner = np.where(tp.kind == MotionKind.DWELL, np.arange(n), np.maximum(np.arange(n) - 1, 0))
-    has = p.pause_s[:n] > 0
-    pause_block[at[:n][has]] = owner[has]
-    return _Command(cuts, speed, block, pause, pause_block)
+    ramp = None
+    if control.rapid_ramp:
+        step = fir_rapids.step_mm_s(machine, path_limits(tp, machine), fir.t1_s, fir.t2_s)
+        ramp = np.where(tp.kind == MotionKind.RAPID, step, np.nan)
+    return Plan(feed, v, pause, ramp)
 
 
 #: Largest distance between an arc and the chords the command is interpolated on (mm).
@@ -614,7 +530,9 @@ def prepare(toolpath: Toolpath, machine: Machine, control: FirControl) -> Prepar
     if len(tp) == 0:
         return None
     geo = PathGeometry(tp)
-    cmd = _command(tp, geo, plan(tp, machine, control, geo=geo), fir)
+    cmd = _command(
+        tp, geo, plan(tp, machine, control, geo=geo), fir.length_s, fir.t1_s, fir.period_s
+    )
     machine = enforced_machine(machine, control)
     limits = np.array(
         [
