@@ -182,3 +182,28 @@ def test_nist_program_times_sum_an_arcs_chords_per_block(monkeypatch):
         assert t.shape == (len(tp),)
         np.testing.assert_allclose(t, expect * (2 if p == "A" else 3))
     assert notes  # every feature lies outside the all-zero training moves
+
+
+def test_nist_program_without_moves_for_the_networks_says_so(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    from nctwin.chapters import nist_hurco_yours as ny
+    from nctwin.controls import SequenceControl
+    from nctwin.estimate import CycleTime
+    from nctwin.estimate.result import Estimate
+
+    path = tmp_path / "dwell.ngc"
+    path.write_text("G4 P1\nM30\n")
+    cals = {"A.NC": SimpleNamespace(profile=lambda m: m, sequence=SequenceControl())}
+    monkeypatch.setattr(ny, "MACHINES", ("M",))
+    monkeypatch.setattr(ny, "_held_out", lambda name: (None, cals))
+    monkeypatch.setattr(ny, "cycle_time", lambda tp, profile: CycleTime.of(
+        Estimate("planner", "M", np.array([1.0]), tp)))  # fmt: skip
+    monkeypatch.setattr(ny.nist_learned, "program_times", lambda *a: ({}, ()))
+    table = pd.DataFrame({"machine": ["M"], "method": ["calibrated"], "error_pct": [1.0],
+                          "cycle_error_pct": [1.0]})  # fmt: skip
+    result = ny.your_program(path, table)
+    assert set(result.times.method) == {"calibrated", "block_overlap", "cam"}
+    assert result.notes[-1] == ("M: the learned methods not run: no move from the first cut to "
+                                "the M30 for the networks to time.")  # fmt: skip
+    assert list(result.feeds.columns) == ["line", "M_mm_s"]

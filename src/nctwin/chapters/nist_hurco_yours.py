@@ -36,7 +36,8 @@ def _fold_times(tp, lines) -> tuple[dict[str, dict[str, list[CycleTime]]], tuple
         times = {label: [cycle_time(tp, cal.profile(m)) for cal in cals.values()]
                  for label, m in YOUR_METHODS.items()}  # fmt: skip
         nets, outside = nist_learned.program_times(name, tp, window)
-        notes += outside
+        none = f"{name}: the learned methods not run: no move from the first cut to the M30"
+        notes += outside if nets else (f"{none} for the networks to time.",)
         for method in nist_learned.METHODS if nets else ():
             times[method] = [
                 _learned(ct, nets[(file, method)], window, cal.sequence, method)
