@@ -97,36 +97,113 @@ def test_chapter_runner_finds_a_chapter_by_stem_or_path():
     assert by_stem == chapter.resolve_notebook("lee2022_block_overlap.ipynb", root)
 
 
-def test_nist_learned_rows_swap_the_window_moves_and_keep_the_rest(tmp_path, monkeypatch):
-    """Each fold's network time of the window's moves replaces the calibrated estimate's; its
-    dwell, sequence and approach times stay; the table holds the median over the folds."""
+#: A spindle run of three cuts and a dwell, then a retract after the M5 (in the networks'
+#: window, first cut to M30, but not in the motion time): blocks 0 (the approach) to 5.
+NIST_PROGRAM = "G0 X0 Y5\nM3 S1000\nG1 Y0 F600\nG1 X10\nG4 P1\nG1 X20\nM5\nG0 Z10\nM30\n"
+
+
+def test_nist_learned_times_replace_the_window_blocks_and_keep_the_rest(tmp_path, monkeypatch):
+    """Each fold's network time of the window's blocks replaces the calibrated fold's; its
+    dwell, the approach and the sequence stay; the table holds the median over the folds of
+    each time, the figure the fold of the median cycle time."""
     from types import SimpleNamespace
 
     from nctwin.chapters import nist_hurco_yours as ny
+    from nctwin.controls import SequenceControl
+    from nctwin.estimate import CycleTime
+    from nctwin.estimate.result import Estimate
 
-    path = tmp_path / "p.ngc"  # line 1 before the window; lines 2-5 in it (the dwell too)
-    path.write_text("G0 X0\nG1 X10 F600\nG1 X20\nG4 P1\nG1 X30\nM30\n")
-    cal_blocks = np.array([0.5, 1.0, 1.0, 1.0, 1.0])  # the dwell block holds its 1 s
-    fake = SimpleNamespace(
-        motion_time_s=None, cycle_time_s=float(cal_blocks.sum()) + 2.0,  # 2 s of sequence
-        estimate=SimpleNamespace(block_times_s=cal_blocks),
-    )  # fmt: skip
-    cals = {f"{k}.NC": SimpleNamespace(profile=lambda m: m) for k in "ABC"}
-    nets = {("A.NC", "bilstm"): 5.0, ("B.NC", "bilstm"): 9.0, ("C.NC", "bilstm"): 7.0}
-    nets |= {(f, "axis_nn"): 3.0 for f in cals}
+    path = tmp_path / "p.ngc"
+    path.write_text(NIST_PROGRAM)
+    cal_blocks = np.array([0.5, 1.0, 1.0, 1.0, 1.0, 0.5])  # the dwell block holds its 1 s
+    seq = SequenceControl(spindle_start_s=2.0, program_start_s=0.25)
+    cals = {f"{k}.NC": SimpleNamespace(profile=lambda m: m, sequence=seq) for k in "ABC"}
+    nets = {("A.NC", "bilstm"): np.array([0.0, 2, 3, 0, 2, 1]),
+            ("B.NC", "bilstm"): np.array([0.0, 1, 1, 0, 1, 3]),
+            ("C.NC", "bilstm"): np.array([0.0, 1, 2, 0, 1, 1])}  # fmt: skip
+    nets |= {(f, "axis_nn"): np.array([0.0, 1, 1, 0, 1, 0.5]) for f in cals}
     monkeypatch.setattr(ny, "MACHINES", ("M",))
     monkeypatch.setattr(ny, "_held_out", lambda name: (None, cals))
-    monkeypatch.setattr(ny, "cycle_time", lambda tp, profile: fake)
+    monkeypatch.setattr(ny, "cycle_time", lambda tp, profile: CycleTime.of(
+        Estimate("planner", "M", cal_blocks, tp), seq))  # fmt: skip
     monkeypatch.setattr(ny.nist_learned, "program_times", lambda *a: (nets, ("note",)))
     table = pd.DataFrame({"machine": ["M"] * 2, "method": ["calibrated"] * 2,
                           "error_pct": [1.0, -2.0], "cycle_error_pct": [3.0, -4.0]})  # fmt: skip
     result = ny.your_program(path, table)
     assert result.reason is None and result.notes[-1] == "note"
-    t = result.times.set_index("method").predicted_s
-    # calibrated 6.5 s; its window moves 3 s; bilstm median over folds 7 s: 6.5 - 3 + 7
-    assert t.to_dict() == pytest.approx(
-        {"calibrated": 6.5, "block_overlap": 6.5, "cam": 6.5, "bilstm": 10.5, "axis_nn": 6.5}
+    t = result.times.set_index(["time", "method"]).predicted_s
+    # by hand: the calibrated cycle 5 s of blocks + 2 s spindle start + 0.25 s; its motion the
+    # blocks 1-4 (the spindle run). bilstm folds: blocks 0.5 | net | 1 s dwell | net, cycles
+    # 11.75, 9.75, 8.75 s (median B's), motions 8, 4, 5 s (median C's)
+    assert t.to_dict() == pytest.approx({
+        ("cycle", "calibrated"): 7.25, ("cycle", "block_overlap"): 7.25, ("cycle", "cam"): 7.25,
+        ("cycle", "bilstm"): 9.75, ("cycle", "axis_nn"): 7.25,
+        ("motion", "calibrated"): 4.0, ("motion", "block_overlap"): 4.0, ("motion", "cam"): 4.0,
+        ("motion", "bilstm"): 5.0, ("motion", "axis_nn"): 4.0})  # fmt: skip
+    row = result.times[(result.times.method == "calibrated") & (result.times.time == "cycle")]
+    assert (row.half_width_pct.iloc[0], row.high_s.iloc[0]) == pytest.approx((4.0, 7.25 * 1.04))
+    assert row.nominal_pct.iloc[0] == pytest.approx(100 * 2 / 3)
+    # the figure: the moving blocks 0, 1, 2, 4, 5 (5, 5, 10, 10, 10 mm) over the median fold's
+    feeds = result.feeds.set_index("line")
+    assert list(feeds.columns) == ["M_mm_s", "M bilstm_mm_s", "M axis_nn_mm_s"]
+    assert feeds["M bilstm_mm_s"].tolist() == pytest.approx([10, 5, 10, 10, 10 / 3])
+    assert feeds["M_mm_s"].tolist() == pytest.approx([10, 5, 10, 10, 20])
+
+
+def test_nist_program_times_sum_an_arcs_chords_per_block(monkeypatch):
+    """Every fold's networks over the window's moves: the mean over the seeds, the chords of an
+    arc summed into its block, nothing outside the window or for a dwell."""
+    from types import SimpleNamespace
+
+    from nctwin.chapters import nist_learned as nl
+    from nctwin.runtimes import motion_window, timed_lines
+
+    text = "G0 X0 Y0\nM3 S1000\nG1 X10 F600\nG2 X20 Y0 I5 J0\nG4 P1\nG1 X30\nM30\n"
+    tp = gcode.parse(text, source="p.ngc")
+    window = motion_window(tp, timed_lines(tp, text, "p.ngc"))
+    train = SimpleNamespace(features=np.zeros((1, 7)))
+    folds = [SimpleNamespace(program=p, rapid_mm_s=500.0, pieces=(train,)) for p in "AB"]
+    seeds = (0, 1, 2)
+    models = {(p, m, s): ([float(s) + (p == "B")], None)
+              for p in "AB" for m in nl.METHODS for s in seeds}  # fmt: skip
+    monkeypatch.setattr(nl, "train_folds", lambda name, seeds: (folds, models))
+    # a move's time: its length over 10 mm/s times (1 + the net's number)
+    monkeypatch.setattr(
+        nl, "_move_times", lambda method, nets, data: data.features[:, 1] / 10 * (1 + nets[0])
     )
-    row = result.times[result.times.method == "calibrated"].iloc[0]
-    assert (row.half_width_pct, row.high_s) == pytest.approx((4.0, 6.5 * 1.04))
-    assert row.nominal_pct == pytest.approx(100 * 2 / 3)
+    times, notes = nl.program_times("M", tp, window, seeds)
+    assert sorted(times) == [(p, m) for p in "AB" for m in sorted(nl.METHODS)]
+    assert window.tolist() == [False, True, True, True, True]
+    # the approach (outside the window) and the dwell (no length) 0; the half circle of 5 mm
+    # radius in 32 chords of pi / 32 rad (at most 0.1 rad each), their summed length
+    expect = np.array([0.0, 10, 32 * 2 * 5 * np.sin(np.pi / 64), 0, 10]) / 10
+    for (p, _), t in times.items():
+        # mean over seeds of (1 + s (+1 for B)): 2 for A, 3 for B
+        assert t.shape == (len(tp),)
+        np.testing.assert_allclose(t, expect * (2 if p == "A" else 3))
+    assert notes  # every feature lies outside the all-zero training moves
+
+
+def test_nist_program_without_moves_for_the_networks_says_so(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    from nctwin.chapters import nist_hurco_yours as ny
+    from nctwin.controls import SequenceControl
+    from nctwin.estimate import CycleTime
+    from nctwin.estimate.result import Estimate
+
+    path = tmp_path / "dwell.ngc"
+    path.write_text("G4 P1\nM30\n")
+    cals = {"A.NC": SimpleNamespace(profile=lambda m: m, sequence=SequenceControl())}
+    monkeypatch.setattr(ny, "MACHINES", ("M",))
+    monkeypatch.setattr(ny, "_held_out", lambda name: (None, cals))
+    monkeypatch.setattr(ny, "cycle_time", lambda tp, profile: CycleTime.of(
+        Estimate("planner", "M", np.array([1.0]), tp)))  # fmt: skip
+    monkeypatch.setattr(ny.nist_learned, "program_times", lambda *a: ({}, ()))
+    table = pd.DataFrame({"machine": ["M"], "method": ["calibrated"], "error_pct": [1.0],
+                          "cycle_error_pct": [1.0]})  # fmt: skip
+    result = ny.your_program(path, table)
+    assert set(result.times.method) == {"calibrated", "block_overlap", "cam"}
+    assert result.notes[-1] == ("M: the learned methods not run: no move from the first cut to "
+                                "the M30 for the networks to time.")  # fmt: skip
+    assert list(result.feeds.columns) == ["line", "M_mm_s"]

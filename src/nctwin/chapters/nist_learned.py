@@ -60,6 +60,7 @@ from ..estimate.learned import (
     MoveData,
     axis_nn_move_times,
     bilstm_move_times,
+    model_blocks,
     move_data,
     train_configs,
 )
@@ -581,7 +582,7 @@ def move_feeds(
 
 def program_times(
     machine_name: str, tp: Toolpath, window: np.ndarray, seeds: Sequence[int] = (0, 1, 2, 3, 4)
-) -> tuple[dict[tuple[str, str], float], tuple[str, ...]]:
+) -> tuple[dict[tuple[str, str], np.ndarray], tuple[str, ...]]:
     """A reader's program as every fold's networks predict it, never retrained for it.
 
     Parameters
@@ -596,24 +597,32 @@ def program_times(
     Returns
     -------
     times : dict
-        ``(held-out program, method)`` to the networks' own time of the window's moves (s, no
-        floor, no dwell), the mean of ``seeds``' (the ensemble, as :func:`learned_predictions`'
-        rows are averaged in the chapter's table); empty where the window has no move.
+        ``(held-out program, method)`` to the networks' own time of each block, ndarray of
+        shape (N,) (s, no floor): a block of the window the sum of its moves' (an arc's
+        chords, :func:`~nctwin.estimate.learned.model_blocks`), each move's time the mean of
+        ``seeds``' (the ensemble, as :func:`learned_predictions`' rows are averaged in the
+        chapter's table); 0 outside the window, for a dwell and a block of no length. Empty
+        where the window has no move.
     notes : tuple of str
         :func:`~nctwin.chapters.your_program.domain_notes` of the moves' features against every
         fold's training moves.
     """
     folds, models = train_folds(machine_name, seeds)
+    blocks = np.flatnonzero(window)
+    part = tp.take(blocks)
+    source = blocks[model_blocks(part)[1]]
     times, x = {}, None
     for fold in folds:
         machine = base_machine(machine_name, fold.rapid_mm_s)
-        data = move_data(fold.program, tp.take(window), machine, CONTROL)
+        data = move_data(fold.program, part, machine, CONTROL)
         if not len(data.moves):
             return {}, ()
         x = data.features
         for method in METHODS:
-            each = [_move_times(method, models[(fold.program, method, s)][0], data).sum()
+            each = [_move_times(method, models[(fold.program, method, s)][0], data)
                     for s in seeds]  # fmt: skip
-            times[(fold.program, method)] = float(np.mean(each))
+            times[(fold.program, method)] = np.bincount(
+                source, weights=np.mean(each, axis=0), minlength=len(tp)
+            )
     train = np.concatenate([p.features for f in folds for p in f.pieces])
     return times, domain_notes(x, train, FEATURES, rows=f"moves, {machine_name}")

@@ -175,8 +175,9 @@ def show_program(result: ProgramResult, *, truth_label: str = "truth") -> None:
 def _plot_feeds(feeds: pd.DataFrame, name: str, truth_label: str) -> None:
     import matplotlib.pyplot as plt
 
-    _, ax = plt.subplots(figsize=(9, 3.2), constrained_layout=True)
-    for i, col in enumerate(c for c in feeds.columns if c != "line"):
+    fig, ax = plt.subplots(figsize=(9, 3.2), constrained_layout=True)
+    cols = [c for c in feeds.columns if c != "line"]
+    for i, col in enumerate(cols):
         label = truth_label if col == "true_mm_s" else col.removesuffix("_mm_s")
         style = (
             {"color": "0.3", "lw": 1.0}
@@ -188,7 +189,10 @@ def _plot_feeds(feeds: pd.DataFrame, name: str, truth_label: str) -> None:
     ax.set_ylabel("average feed (mm/s)")
     ax.set_ylim(bottom=0)
     ax.set_title(f"{name}: average feed per G-line")
-    ax.legend(loc="lower right", frameon=False)
+    if len(cols) > 3:  # many sources: the legend beside the axes, off the lines
+        fig.legend(loc="outside right upper", frameon=False)
+    else:
+        ax.legend(loc="lower right", frameon=False)
     plt.show()
 
 
