@@ -417,18 +417,19 @@ def transfer(
     *,
     seed: int,
     progress: bool = True,
+    prefix: str = "zhang2023",
 ) -> list[TransferRun]:
     """Fine-tune ``start`` on ``shares_pct`` % of the samples of ``data`` and predict the rest
     (Tables 4-7); 0 % predicts every sample with ``start`` unchanged.
 
     Each share draws its rows with :func:`split` (seed ``seed``); the fine-tuning keeps the
-    start network's scalers.
+    start network's scalers. ``prefix`` begins the checkpoints' names.
     """
     runs = []
     for pct in shares_pct:
         picked, rest = split(len(data.x), pct / 100.0, seed=seed)
         if len(picked):
-            name = f"zhang2023_s{data.index}_ft{pct:g}_seed{train_config.seed}"
+            name = f"{prefix}_s{data.index}_ft{pct:g}_seed{train_config.seed}"
             tuned = train(
                 data, picked, start.model.config, train_config, name=name, init=start,
                 progress=progress,
