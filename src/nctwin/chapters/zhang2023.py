@@ -29,8 +29,9 @@ Configurations
     momentum 0.8, lr 1e-2, batches of 128 rows, MSE, dropout as given; the same early stopping
     and cap as the paper's settings.
 :func:`finetune_configs`
-    Fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr 3e-3, capped
-    at :data:`FINETUNE_EPOCHS`.
+    The variant's fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr
+    3e-3, capped at :data:`FINETUNE_EPOCHS`. The paper's settings fine-tune with
+    :func:`paper_configs` themselves (the paper gives no others).
 
 Every network stops once its validation loss has not improved for :data:`PAPER_PATIENCE`
 epochs, or at its cap: the paper's :data:`PAPER_EPOCHS`, :data:`FINETUNE_EPOCHS` for
