@@ -29,8 +29,9 @@ Configurations
     momentum 0.8, lr 1e-2, batches of 128 rows, MSE, dropout as given; the same early stopping
     and cap as the paper's settings.
 :func:`finetune_configs`
-    Fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr 3e-3, capped
-    at :data:`FINETUNE_EPOCHS`.
+    The variant's fine-tuning to a new surface (Tables 4-7): the variant without dropout at lr
+    3e-3, capped at :data:`FINETUNE_EPOCHS`. The paper's settings fine-tune with
+    :func:`paper_configs` themselves (the paper gives no others).
 
 Every network stops once its validation loss has not improved for :data:`PAPER_PATIENCE`
 epochs, or at its cap: the paper's :data:`PAPER_EPOCHS`, :data:`FINETUNE_EPOCHS` for
@@ -417,18 +418,19 @@ def transfer(
     *,
     seed: int,
     progress: bool = True,
+    prefix: str = "zhang2023",
 ) -> list[TransferRun]:
     """Fine-tune ``start`` on ``shares_pct`` % of the samples of ``data`` and predict the rest
     (Tables 4-7); 0 % predicts every sample with ``start`` unchanged.
 
     Each share draws its rows with :func:`split` (seed ``seed``); the fine-tuning keeps the
-    start network's scalers.
+    start network's scalers. ``prefix`` begins the checkpoints' names.
     """
     runs = []
     for pct in shares_pct:
         picked, rest = split(len(data.x), pct / 100.0, seed=seed)
         if len(picked):
-            name = f"zhang2023_s{data.index}_ft{pct:g}_seed{train_config.seed}"
+            name = f"{prefix}_s{data.index}_ft{pct:g}_seed{train_config.seed}"
             tuned = train(
                 data, picked, start.model.config, train_config, name=name, init=start,
                 progress=progress,

@@ -1,8 +1,11 @@
 """The Zhang chapter's conditions and claims: the paper's surfaces and paths beside ours
 (:func:`paper_conditions`, written before any network is scored), and the claims
 (:func:`judged_claims`): the paper's at its bars on the paper's recipe, one network at a time
-("k of n") with a bootstrap interval over the seeds; the modified recipe as rows of ours; Table 8
-as the paper's claim and the chapter's three counter-claims.
+("k of n") with a bootstrap interval over the seeds, its fine-tuning to surfaces 2 and 3 with
+its own settings; the modified recipe as rows of ours; Table 8 as the paper's claim (its ratio
+rounded up to a power of ten, so that the kept value and margin repeat) and the chapter's three
+counter-claims (rankings in one run). Every claim text says which recipe it judges and the
+epochs its runs reached.
 """
 
 from __future__ import annotations
@@ -17,15 +20,25 @@ import pandas as pd
 from ..report.claims import bootstrap_interval, claims_by_seed, with_seeds
 from ..report.conditions import Condition
 from ..report.tables import Claim
+from .zhang2023 import FINETUNE_EPOCHS
 from .zhang2023_seeds import Networks
 from .zhang2023_surfaces import SurfaceData
 
-__all__ = ["MAX_ERR_TOL_PCT", "judged_claims", "paper_conditions", "recipe_text", "time_ratio"]
+__all__ = [
+    "MAX_ERR_TOL_PCT",
+    "TIME_RATIO_FLOOR",
+    "judged_claims",
+    "paper_conditions",
+    "recipe_text",
+    "time_ratio",
+]
 
 #: Tolerance of our largest step error against the paper's (printed as whole µm), stated
 #: before looking.
 MAX_ERR_TOL_PCT = 10.0
 _PAPER = "Zhang et al. 2023"
+#: The network timed for Table 8 (a network's time depends on its architecture, not its weights).
+_NET = "the network of the paper's recipe fine-tuned to surface 2 (the chapter's seed)"
 
 
 def paper_conditions(
@@ -91,22 +104,49 @@ def _requires(conditions: list[Condition], *surfaces: int) -> tuple[str, ...]:
                  if c.id.startswith(f"s{s}_") and not c.id.endswith("err_above_min"))  # fmt: skip
 
 
+def _stopped(epochs, cap: float) -> str:
+    """How the runs ended: the epochs they reached, and whether early stopping or the cap
+    ended them."""
+    epochs = np.asarray(epochs, dtype=int)
+    how = (
+        "stopped by early stopping"
+        if epochs.max() < cap
+        else "stopped by early stopping or the cap"
+    )
+    return f"{how} at epochs {epochs.min()}-{epochs.max()} of a {cap:g} cap"
+
+
 def recipe_text(q: pd.Series, epochs: np.ndarray) -> str:
     """The paper's recipe in words, its numbers read from ``q`` (the summary's values), and the
     epochs the runs reached."""
     return (f"the paper's recipe (N(0, {q['weight_init_std']:g}) weights, dropout "
             f"{q['dropout_p']:g}, SGD with momentum {q['momentum']:g}, learning rate "
-            f"{q['learning_rate']:g}, full batch, stopped by early stopping at epochs "
-            f"{int(epochs.min())}-{int(epochs.max())} of a {q['epochs']:g} cap)")  # fmt: skip
+            f"{q['learning_rate']:g}, full batch, {_stopped(epochs, q['epochs'])})")  # fmt: skip
+
+
+def _variant_text(epochs, cap: float, dropout: str = "no dropout") -> str:
+    return (f"the modified recipe (uniform initial weights, learning rate 1e-2, batches of 128, "
+            f"{dropout}, {_stopped(epochs, cap)})")  # fmt: skip
+
+
+def _epochs(runs) -> list[int]:
+    """Epochs each fine-tuning of ``runs`` (TransferRun) reached."""
+    return [len(r.trained.history["train"]) for r in runs]
+
+
+#: The smallest value :func:`time_ratio` keeps: the ratio measured here (about 0.002 to 0.003
+#: between runs, the lower on a loaded machine) lies near the power of ten below it.
+TIME_RATIO_FLOOR = 0.01
 
 
 def time_ratio(timing: pd.DataFrame) -> float:
     """The network's time (prediction with model import) over the iterative geometric
-    method's, rounded up to a power of ten (a timing ratio varies between runs; its decade
-    does not, at the margins of this chapter)."""
+    method's, rounded up to a power of ten and at least :data:`TIME_RATIO_FLOOR`: an upper
+    bound of the measured ratio that repeats from run to run (the ratio itself moves with the
+    machine's load, by tens of percent)."""
     s = timing.set_index("method")["seconds"]
     ratio = s["nn_prediction_with_model_import"] / s["geometric_iterative"]
-    return float(10.0 ** np.ceil(np.log10(ratio)))
+    return float(max(10.0 ** np.ceil(np.log10(ratio)), TIME_RATIO_FLOOR))
 
 
 def _learned(claim: Claim, per_seed: np.ndarray, statistic: Callable) -> tuple[Claim, list]:
@@ -138,15 +178,17 @@ def judged_claims(
     3's share (``surface1_abs_err_lt_0p5um``) rounded down to 0.1, its largest error within Table
     3's, each on the mean of the seeds' networks with "k of n" single networks and a bootstrap
     interval; dropout lowering the test MSE (Fig. 6; the batch sweep's full-batch runs, the
-    chapter's seed); surfaces 2 and 3 after 15 % fine-tuning above the abstract's 99 % below 1 um
-    (not tested: the paper's recipe is not fine-tuned here); Table 8, the network's time over the
-    geometric method's at most Table 8's ratio (rounded up to a power of ten, :func:`time_ratio`).
+    chapter's seed); surfaces 2 and 3 after 15 % fine-tuning with the paper's settings above the
+    abstract's 99 % below 1 um (not tested where a seed has no chain); Table 8, the network's time
+    over the geometric method's at most Table 8's ratio (rounded up to a power of ten,
+    :func:`time_ratio`), with the margin that rounded value leaves.
     Ours: the same accuracy claims on the modified recipe, more fine-tuning never worse, and the
     exact vectorised method faster than the network in three readings (rankings in one run).
 
     Parameters
     ----------
     networks : Networks
+        Its ``paper_transfer2``/``paper_transfer3`` chains end with the 15 % fine-tuning.
     data : dict
         Surface -> SurfaceData.
     train_rows, test_rows : ndarray of int
@@ -181,10 +223,10 @@ def judged_claims(
     y_std = float(data[1].y_um[train_rows].std())
     recipes = {"paper": networks.paper, "variant": networks.variant}
     preds = {k: np.array([predict(n, x1) for n in nets]) for k, nets in recipes.items()}
-    epochs = per_seed[per_seed.network == "paper settings (p = 0.5)"]["epochs"].dropna()
-    paper_recipe = recipe_text(q, epochs.to_numpy())
-    variant = ("the modified recipe (uniform initial weights, learning rate 1e-2, batches of "
-               "128, no dropout)")  # fmt: skip
+    labels = ("paper settings (p = 0.5)", "variant (p = 0)", "variant (p = 0.5)")
+    epochs = {k: per_seed[per_seed.network == k]["epochs"].dropna().to_numpy() for k in labels}
+    paper_recipe = recipe_text(q, epochs["paper settings (p = 0.5)"])
+    variant = _variant_text(epochs["variant (p = 0)"], q["epochs"])
 
     def below(bar, y):
         return lambda rows: 100.0 * float(np.mean(np.abs(rows.mean(axis=0) - y) < bar))
@@ -225,12 +267,14 @@ def judged_claims(
                         f"without; {_PAPER}, Fig. 6)",
                         full.loc[(0, 0.5), "test_mse"] - full.loc[(0, 0.0), "test_mse"], "<", 0.0,
                         requires=s1))  # fmt: skip
+    with_dropout = _variant_text(epochs["variant (p = 0.5)"], q["epochs"],
+                                 f"dropout {q['dropout_p']:g}")  # fmt: skip
     pairs = np.stack([[predict(n, x1) for n in networks.dropout], preds["variant"]], axis=1)
     c, a = _learned(
         Claim(
             "dropout_helps_variant",
-            f"The modified recipe with dropout {q['dropout_p']:g} and "
-            "without: dropout gives a lower test MSE (value: with minus without)",
+            f"Surface 1, {with_dropout}, against {variant}: dropout gives a lower test MSE "
+            "(value: with minus without)",
             mse_gap(pairs),
             "<",
             0.0,
@@ -242,31 +286,33 @@ def judged_claims(
     )
     judged.append(c)
     alone.append(a)
-    for s in (2, 3):
-        need = (*_requires(conditions, 1, 2, s), "paper_recipe_fine_tuned")
-        judged.append(Claim(f"surface{s}_15pct_share_below_1um", f"Surface {s} after "
-                            f"fine-tuning {paper_recipe} with 15 % of its samples: > "
-                            f"{bar_1um:g} % below 1 um ({_PAPER}, Abstract, Table {s + 4})",
-                            float("nan"), ">", bar_1um, requires=need))  # fmt: skip
-        chains = networks.transfer2 if s == 2 else networks.transfer3
-        runs = [chain[-1] for chain in chains]
+    chains = {("paper", 2): networks.paper_transfer2, ("paper", 3): networks.paper_transfer3,
+              ("variant", 2): networks.transfer2, ("variant", 3): networks.transfer3}  # fmt: skip
+    for s, recipe in itertools.product((2, 3), ("paper", "variant")):
+        runs = [chain[-1] for chain in chains[recipe, s]] if all(chains[recipe, s]) else []
+        if recipe == "paper":
+            how = (
+                f"the paper's recipe with the same settings ("
+                f"{_stopped(_epochs(runs), q['epochs'])})"
+                if runs
+                else "the paper's recipe"
+            )
+            key, whose, cite = "", "paper", f" ({_PAPER}, Abstract, Table {s + 4})"
+            need = (*_requires(conditions, 1, 2, s), "paper_recipe_fine_tuned")
+        else:
+            how = (f"the modified recipe's network at learning rate 3e-3 ("
+                   f"{_stopped(_epochs(runs), FINETUNE_EPOCHS)})")  # fmt: skip
+            key, whose, cite, need = "_variant", "ours", "", _requires(conditions, 1, 2, s)
+        claim = Claim(f"surface{s}_15pct_share_below_1um{key}", f"Surface {s} after fine-tuning "
+                      f"{how} with 15 % of its samples: > {bar_1um:g} % below 1 um{cite}",
+                      float("nan"), ">", bar_1um, whose=whose, requires=need)  # fmt: skip
+        if not runs:  # a seed not fine-tuned: not tested (``paper_recipe_fine_tuned`` unmet)
+            judged.append(claim)
+            continue
         y = data[s].exact.error_um[runs[0].test_rows]
         rows = np.array([r.predicted_um for r in runs])
-        c, a = _learned(
-            Claim(
-                f"surface{s}_15pct_share_below_1um_variant",
-                f"Surface {s} after "
-                f"fine-tuning {variant} with 15 % of its samples: > {bar_1um:g} % "
-                "below 1 um",
-                below(1.0, y)(rows),
-                ">",
-                bar_1um,
-                whose="ours",
-                requires=_requires(conditions, 1, 2, s),
-            ),
-            rows,
-            below(1.0, y),
-        )
+        c, a = _learned(dataclasses.replace(claim, value=below(1.0, y)(rows)), rows,
+                        below(1.0, y))  # fmt: skip
         judged.append(c)
         alone.append(a)
     share = transfer_tab.set_index(["surface", "finetune_pct"])["share_below_1um_pct"]
@@ -274,7 +320,7 @@ def judged_claims(
     t8 = paper_t8.pivot(index="surface", columns="method", values="time_s")
     bar_t8 = float((t8["proposed"] / t8["geometric"]).max())
     seconds = timing.set_index("method")["seconds"]
-    t_exact = seconds["exact_vectorised"]
+    t_exact, ratio = seconds["exact_vectorised"], time_ratio(timing)
     ranks = {
         "exact_faster_than_nn": (
             "the network's prediction with model import (Table 8's definition)",
@@ -296,12 +342,16 @@ def judged_claims(
               "lower the share below 1 um by more than noise (value: largest drop between "
               "consecutive shares, surfaces 2 and 3; noise: 1 percentage point)", max(drops),
               "<=", 1.0, whose="ours", requires=_requires(conditions, 1, 2, 3)),
-        Claim("table8_time_ratio", "Surface 2: the network's time (prediction with model import) "
-              "over the iterative geometric method's, rounded up to a power of ten, at most "
-              f"Table 8's largest ratio ({_PAPER}, Table 8, Abstract: 'one-third'; one run on "
-              "this CPU)", time_ratio(timing), "<=", bar_t8, requires=_requires(conditions, 2)),
-        *(Claim(key, f"The exact vectorised step error is faster than {what}; 1 = yes, in one "
-                "run", float(t_exact < t), "==", 1.0, whose="ours")
+        Claim("table8_time_ratio", f"Surface 2, {_NET}: its time (prediction with model "
+              "import) over the iterative geometric method's, rounded up to a power of ten and "
+              f"at least {TIME_RATIO_FLOOR:g} ({ratio:g}: the ratio measured in one run on this "
+              "CPU lies below it), at most "
+              f"Table 8's largest ratio ({bar_t8:.3f}): a margin of at least {bar_t8 / ratio:.0f}x "
+              f"({_PAPER}, Table 8, Abstract: 'one-third')", ratio, "<=", bar_t8,
+              requires=_requires(conditions, 2)),
+        *(Claim(key, f"Surface 2, {_NET}: the exact vectorised step error is faster than "
+                f"{what}; 1 = yes, the ranking in one run (its margin is not kept: times vary "
+                "between runs)", float(t_exact < t), "==", 1.0, whose="ours")
           for key, (what, t) in ranks.items()),
     ]  # fmt: skip
     learned = [c for c in judged if c.seeds is not None]

@@ -4,16 +4,20 @@
 :func:`nctwin.runner.run_tasks` (one task per network, or per chain of networks that start from
 one another; one torch thread each, so the weights do not depend on the worker or the order):
 
-* the networks the claims judge, once per seed: the paper's settings (full batch, dropout 0.5),
-  the converging variant with dropout 0.5 and without, and the fine-tuning chains of the
-  variant without dropout to surfaces 2 and 3 (each seed fine-tunes its own network);
+* the networks the claims judge, once per seed: the paper's settings (full batch, dropout 0.5)
+  and its fine-tuning chain to surfaces 2 and 3 at 15 % with the same settings (the paper gives
+  no others; the claims judge 15 %), the converging variant with dropout 0.5 and without, and
+  the fine-tuning chains of the variant without dropout to surfaces 2 and 3 at every share (each
+  seed fine-tunes its own network);
 * the sweeps and diagnostics, once (the chapter's seed): the batch sweep, the dropout sweep
   (Table 2) and the network trained from scratch on surface 2.
 
 Every network trains until early stopping ends it, under a cap that it does not reach (the
-paper's 2000 epochs on surface 1, :data:`~nctwin.chapters.zhang2023.FINETUNE_EPOCHS` for
-fine-tuning), except the batch sweep's runs at 32 and 256 rows, which have a budget
-(:data:`~nctwin.chapters.zhang2023.BATCH_SWEEP_EPOCHS`).
+paper's 2000 epochs on surface 1 and for the paper's settings' fine-tuning,
+:data:`~nctwin.chapters.zhang2023.FINETUNE_EPOCHS` for the variant's fine-tuning), except the
+batch sweep's runs at 32 and 256 rows, which have a budget
+(:data:`~nctwin.chapters.zhang2023.BATCH_SWEEP_EPOCHS`), and the batch sweep's full batch without
+dropout, which reaches the paper's 2000.
 
 The data splits (70/30 on surface 1, the fine-tuning rows) are drawn from the chapter's seed and
 are the same for every training seed. The claims judge the **mean of the seeds' predictions**
@@ -65,6 +69,10 @@ class Networks:
     paper, dropout, variant : list of Trained
         One per seed: the paper's settings (full batch, dropout 0.5), the variant with dropout
         0.5 and the variant without dropout (surface 1).
+    paper_transfer2, paper_transfer3 : list of list of TransferRun
+        One list per seed, at 0 and 15 %: the seed's paper-settings network fine-tuned to
+        surface 2 with the paper's settings, and its 15 % surface-2 network fine-tuned to
+        surface 3.
     transfer2, transfer3 : list of list of TransferRun
         One list per seed: the seed's variant fine-tuned to surface 2 at every share, and its
         15 % surface-2 network fine-tuned to surface 3.
@@ -83,6 +91,8 @@ class Networks:
     paper: list[Trained]
     dropout: list[Trained]
     variant: list[Trained]
+    paper_transfer2: list[list[TransferRun]]
+    paper_transfer3: list[list[TransferRun]]
     transfer2: list[list[TransferRun]]
     transfer3: list[list[TransferRun]]
     sweep: dict[float, Trained | None]
@@ -106,6 +116,20 @@ def _chain(d1, train_rows, d2, d3, shares, seed, train_seed):
     _, ft = finetune_configs(n, seed=train_seed)
     runs2 = transfer(net1, d2, shares, ft, seed=seed, progress=False)
     runs3 = transfer(runs2[-1].trained, d3, shares, ft, seed=seed, progress=False)
+    return net1, runs2, runs3
+
+
+def _paper_chain(d1, train_rows, d2, d3, seed, train_seed):
+    """The paper's settings (seed ``train_seed``) and their fine-tuning chain at 0 and 15 %,
+    with the same settings; None and empty chains if surface 1's training diverged."""
+    cfgs = paper_configs(d1.x.shape[1], seed=train_seed)
+    net1 = _train_or_none(d1, train_rows, *cfgs, f"zhang2023_paper_seed{train_seed}")
+    if net1 is None:
+        return None, [], []
+    shares, name = (0.0, 15.0), "zhang2023_paper"
+    runs2 = transfer(net1, d2, shares, cfgs[1], seed=seed, progress=False, prefix=name)
+    runs3 = transfer(runs2[-1].trained, d3, shares, cfgs[1], seed=seed, progress=False,
+                     prefix=name)  # fmt: skip
     return net1, runs2, runs3
 
 
@@ -156,8 +180,7 @@ def train_networks(
     for s in seeds:
         tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, seed, s)
     for s in seeds:
-        cfgs = paper_configs(n, seed=s)
-        tasks["paper", s] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_paper_seed{s}")
+        tasks["paper", s] = task(_paper_chain, d1, train_rows, d2, data[3], seed, s)
     for s in seeds:
         cfgs = variant_configs(n, dropout=0.5, seed=s)
         tasks["dropout", s] = task(_train_or_none, d1, train_rows, *cfgs,
@@ -176,17 +199,20 @@ def train_networks(
     tasks["scratch"] = task(_train_or_none, d2, picked2, *cfgs, "zhang2023_s2_scratch15")
     out = dict(zip(tasks, run_tasks(_call, tasks.values(), n_jobs=n_jobs), strict=True))
     chains = [out["chain", s] for s in seeds]
+    papers = [out["paper", s] for s in seeds]
     same = {0.0: chains[0][0], 0.5: out["dropout", s0]}  # the sweep's runs trained already
     return Networks(
         seeds=tuple(seeds),
-        paper=[out["paper", s] for s in seeds],
+        paper=[c[0] for c in papers],
         dropout=[out["dropout", s] for s in seeds],
         variant=[c[0] for c in chains],
+        paper_transfer2=[c[1] for c in papers],
+        paper_transfer3=[c[2] for c in papers],
         transfer2=[c[1] for c in chains],
         transfer3=[c[2] for c in chains],
         sweep={p: same[p] if p in same else out["sweep", p] for p in probabilities},
         batches={
-            (b, p): out["paper", s0] if (b, p) == (None, 0.5) else out["batch", b, p]
+            (b, p): papers[0][0] if (b, p) == (None, 0.5) else out["batch", b, p]
             for b, p in BATCH_RUNS
         },
         scratch=out["scratch"],

@@ -57,7 +57,11 @@ def _bins(paper: pd.DataFrame, metric: str) -> list[tuple[str, float, float]]:
 
 
 def error_histogram(
-    predicted_um: np.ndarray, exact_um: np.ndarray, paper: pd.DataFrame
+    predicted_um: np.ndarray,
+    exact_um: np.ndarray,
+    paper: pd.DataFrame,
+    *,
+    min_exact_um: float = 0.0,
 ) -> pd.DataFrame:
     """Absolute- and relative-error histograms with the paper's bins, beside the paper's.
 
@@ -68,16 +72,20 @@ def error_histogram(
         A table like ``zhang2023_table3`` (``metric`` ``abs_err`` in um, ``rel_err`` in %,
         ``bin_lo``/``bin_hi``, ``count``, ``ratio_pct``). Bins are [lo, hi); where the paper's
         last absolute bin is closed, one more row counts the errors beyond it.
+    min_exact_um : float
+        Relative errors count only the samples whose exact step error is at least this (the
+        paper's smallest step error: its samples all are); absolute errors count all.
 
     Returns
     -------
     DataFrame
-        ``metric``, ``bin_label``, ``bin_lo``, ``bin_hi``, ``count``, ``ratio_pct``,
-        ``paper_count``, ``paper_ratio_pct``.
+        ``metric``, ``bin_label``, ``bin_lo``, ``bin_hi``, ``count``, ``ratio_pct`` (of
+        ``samples``), ``samples`` (the samples counted), ``paper_count``, ``paper_ratio_pct``.
     """
     abs_err = np.abs(predicted_um - exact_um)
+    kept = exact_um >= min_exact_um
     with np.errstate(divide="ignore", invalid="ignore"):
-        rel_err = np.where(exact_um > 0, abs_err / exact_um * 100.0, np.inf)
+        rel_err = np.where(exact_um > 0, abs_err / exact_um * 100.0, np.inf)[kept]
     rows = []
     for metric, err in (("abs_err", abs_err), ("rel_err", rel_err)):
         ref = paper[paper.metric == metric].set_index("bin_label")
@@ -91,6 +99,7 @@ def error_histogram(
                     "bin_hi": hi,
                     "count": count,
                     "ratio_pct": 100.0 * count / len(err),
+                    "samples": len(err),
                     "paper_count": ref["count"].get(label, np.nan),
                     "paper_ratio_pct": ref["ratio_pct"].get(label, np.nan),
                 }
