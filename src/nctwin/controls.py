@@ -338,14 +338,24 @@ class PlannerControl:
     blend_tol_mm : float
         Blending tolerance where the program sets no ``G64 P`` (LinuxCNC's startup code), in
         [0, 10] mm.
+    dwell_wait_s, spindle_wait_s, coolant_wait_s, tool_change_wait_s : float
+        How long the tool rests, beyond a dwell's own time, where LinuxCNC's task stops it for a
+        dwell, a spindle word (``M3``-``M5``), a coolant word (``M7``-``M9``) or a tool change
+        (``M6``) between two moves (:mod:`nctwin.estimate.task_waits`), each in [0, 600] s.
     """
 
     period_s: float = 0.001
     blend_tol_mm: float = 0.0254
+    dwell_wait_s: float = 0.0
+    spindle_wait_s: float = 0.0
+    coolant_wait_s: float = 0.0
+    tool_change_wait_s: float = 0.0
 
     def __post_init__(self) -> None:
         _check_period(self.period_s)
         _check_tolerance(self.blend_tol_mm)
+        for name in ("dwell_wait_s", "spindle_wait_s", "coolant_wait_s", "tool_change_wait_s"):
+            check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
 
 
 @dataclass(frozen=True)
