@@ -63,6 +63,7 @@ def test_linuxcnc_sim_has_the_fixed_limits():
     assert p.control("planner") == PlannerControl(
         period_s=0.001,
         blend_tol_mm=0.0254,
+        word_stops=True,
         dwell_wait_s=0.003,
         spindle_wait_s=0.004,
         coolant_wait_s=0.12,

@@ -22,7 +22,8 @@ WAITS = dataclasses.replace(
     coolant_wait_s=0.12,
     tool_change_wait_s=0.276,
 )
-NO_WAITS = PlannerControl(period_s=WAITS.period_s, blend_tol_mm=WAITS.blend_tol_mm)
+NO_WAITS = PlannerControl(period_s=WAITS.period_s, blend_tol_mm=WAITS.blend_tol_mm,
+                          word_stops=True)  # fmt: skip
 
 
 def _time(between: str, control: PlannerControl = WAITS, before: str = "") -> float:
@@ -69,3 +70,15 @@ def test_pauses_counted_between_moves_only():
 def test_profile_rests_are_the_measured_ones():
     """The linuxcnc_sim profile holds the rests measured live (see its comment)."""
     assert PROFILE.control("planner") == WAITS
+
+
+def test_without_word_stops_words_take_no_time():
+    """A control that runs M-codes on the fly (word_stops off, the default): M8 is nothing;
+    a dwell still stops the tool."""
+    on_the_fly = PlannerControl(period_s=WAITS.period_s, blend_tol_mm=WAITS.blend_tol_mm)
+    passing = _time("M8", on_the_fly)
+    assert passing < _time("G4 P0", NO_WAITS) - 0.03  # no stop (see above: 0.04 s)
+    assert _time("T1 M6", on_the_fly) == pytest.approx(passing, abs=1e-12)  # nor a rest
+    assert _time("G4 P0", on_the_fly) == pytest.approx(_time("G4 P0", NO_WAITS), abs=1e-12)
+    with pytest.raises(ValueError, match="word_stops = 1 is not allowed"):
+        PlannerControl(word_stops=1)

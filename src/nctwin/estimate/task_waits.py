@@ -13,8 +13,9 @@ and I/O do the command; the times at rest are the ``[control.planner]`` settings
 profile). A pause rests until the operator presses cycle start, which has no defined time:
 here a pause stops the tool and adds nothing (the motion time excludes the operator's wait).
 
-What is modelled: the words of a tool path's events (M-codes) and its dwells, between the
-first and the last move (a wait before the first move or after the last is no part of the
+What is modelled, where the control's ``word_stops`` is on (LinuxCNC's; otherwise only the
+dwells): the words of a tool path's events (M-codes) and its dwells, between the first and the
+last move (a wait before the first move or after the last is no part of the
 motion, as in a recording). Not modelled: ``G43``/``G49`` and offset changes in the middle of
 the motion, which a tool path keeps no event for (measured: 3-4 ms at rest after the stop).
 """
@@ -81,7 +82,7 @@ def task_stops(
     dwell = np.flatnonzero(toolpath.kind == MotionKind.DWELL)
     ev = toolpath.events
     m = np.where(ev["word"] == "M", ev["value"], np.nan)
-    waiting = np.isin(m, list(WAITING_M_CODES))
+    waiting = np.isin(m, list(WAITING_M_CODES)) & control.word_stops
     word_block = ev["block"][waiting]
     moving = merged_source[source]
     merged_dwell = np.flatnonzero(np.isin(merged_source, dwell))
