@@ -60,7 +60,15 @@ def test_linuxcnc_sim_has_the_fixed_limits():
     assert m.axis_max_velocity_mm_s == (200.0, 200.0, 100.0)
     assert m.axis_max_acceleration_mm_s2 == (1000.0, 1000.0, 500.0)
     assert all(math.isinf(j) for j in m.axis_max_jerk_mm_s3)
-    assert p.control("planner") == PlannerControl(period_s=0.001, blend_tol_mm=0.0254)
+    assert p.control("planner") == PlannerControl(
+        period_s=0.001,
+        blend_tol_mm=0.0254,
+        word_stops=True,
+        dwell_wait_s=0.003,
+        spindle_wait_s=0.004,
+        coolant_wait_s=0.12,
+        tool_change_wait_s=0.276,
+    )
     assert p.default_method == "planner" and p.recordings == "linuxcnc"
 
 

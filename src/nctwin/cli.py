@@ -31,6 +31,7 @@ import numpy as np
 from . import __version__
 from .estimate import METHODS, cycle_time
 from .estimate.cycle import OVERRIDE_MAX_PCT
+from .estimate.task_waits import pause_count
 from .gcode import READERS, GCodeError, read
 from .kernel import fir
 from .machine import DEFAULT_MACHINE, Machine, Profile, available_machines, load_profile
@@ -84,6 +85,8 @@ The cycle time is program start to end: the method's motion plus, where the prof
 optional stops (M1 outside a tool change) and program start and end. The motion time runs,
 for each spindle start, from the first move after it to the M5 (or M6, M2, M30) that stops
 it, summed; none where the program starts no spindle. The breakdown splits the cycle time.
+A program pause (M0, M1) between moves stops the tool; the operator's wait that follows has no
+defined time and is not counted (a "pauses" line says how many).
 
 examples:
   nctwin estimate part.nc
@@ -442,6 +445,11 @@ def _estimate(args: argparse.Namespace, enabled: bool) -> int:
     motion = ct.motion_time_s
     rows.insert(5, ("motion time", "none (no spindle start)" if motion is None else
                     f"{motion:.3f} s  ({_format_duration(motion)})"))  # fmt: skip
+    pauses = pause_count(tp)
+    if pauses:  # an operator ends them: no defined time
+        rows.insert(6, ("pauses", f"{pauses} M0/M1 between moves: the operator's wait is not "
+                                  "counted (the tool stops, then waits 0 s)"))  # fmt: skip
+        summary["pauses_not_timed"] = pauses
     if (args.rapid_override, args.feed_override) != (100.0, 100.0):
         rows.insert(6, ("overrides", f"rapid {args.rapid_override:g} %, feed "
                                      f"{args.feed_override:g} %"))  # fmt: skip

@@ -347,14 +347,33 @@ class PlannerControl:
     blend_tol_mm : float
         Blending tolerance where the program sets no ``G64 P`` (LinuxCNC's startup code), in
         [0, 10] mm.
+    word_stops : bool
+        True: the tool stops before the M-codes LinuxCNC's task waits for the motion to end
+        for (:mod:`nctwin.estimate.task_waits`), as on LinuxCNC; False (default, a control
+        that runs them on the fly): they neither stop it nor take time.
+    dwell_wait_s, spindle_wait_s, coolant_wait_s, tool_change_wait_s : float
+        How long the tool rests, beyond a dwell's own time, where the task stops it for a
+        dwell, a spindle word (``M3``-``M5``), a coolant word (``M7``-``M9``) or a tool change
+        (``M6``) between two moves (the words' with ``word_stops`` only), each in [0, 600] s.
     """
 
     period_s: float = 0.001
     blend_tol_mm: float = 0.0254
+    word_stops: bool = False
+    dwell_wait_s: float = 0.0
+    spindle_wait_s: float = 0.0
+    coolant_wait_s: float = 0.0
+    tool_change_wait_s: float = 0.0
 
     def __post_init__(self) -> None:
         _check_period(self.period_s)
         _check_tolerance(self.blend_tol_mm)
+        if not isinstance(self.word_stops, bool):
+            raise ValueError(
+                f"word_stops = {self.word_stops!r} is not allowed: allowed True, False"
+            )
+        for name in ("dwell_wait_s", "spindle_wait_s", "coolant_wait_s", "tool_change_wait_s"):
+            check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
 
 
 @dataclass(frozen=True)

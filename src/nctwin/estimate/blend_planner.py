@@ -105,8 +105,8 @@ whole servo periods (below), which adds less than 1 ms to a program that stops o
 Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits
 (``tpChooseBestBlend`` is applied at junctions with an arc only), a line consumed by a blend
 into the last move (LinuxCNC compares with the blend's planned speed; here with the junction's
-speed, which is lower into a short last move), the time LinuxCNC's task takes around a dwell
-(2-4 ms). The rules for junctions with an arc
+speed, which is lower into a short last move). The stops and rests of LinuxCNC's task around
+dwells and M-codes are :mod:`~nctwin.estimate.task_waits`'. The rules for junctions with an arc
 (:mod:`~nctwin.estimate.blend_junctions`) came from the public programs ``blur_torus`` and
 ``LHchips4`` (-2.7 and -2.1 % before them, +0.07 and -0.48 % with them), each read in
 LinuxCNC's source and checked live on 70 short programs of an arc, a line of 0.126 or 1 mm
@@ -168,6 +168,7 @@ from .blend_junctions import (
 )
 from .blend_speeds import optimised_end_speeds, segment_times, stops_on_periods
 from .result import Estimate
+from .task_waits import task_stops
 
 __all__ = [
     "KINK_RATIO",
@@ -540,9 +541,9 @@ def blend_planner(
     given = np.where(np.isfinite(own) & (own > 0), own, np.inf)
     tol = own.copy()
     tol[1:] = np.where(own[:-1] == 0, 0.0, np.minimum(given[:-1], given[1:]))
-    # a dwell between two moves stops the tool; the move before it keeps its parabolic end,
-    # and, like the last move, is never finalized (an arc keeps a / 2, move_limits)
-    after = np.searchsorted(source, np.flatnonzero(merged.kind == MotionKind.DWELL))
+    # a dwell or a word the task waits for (task_waits) stops the tool; the move before it keeps
+    # its parabolic end, and, like the last move, is never finalized (an arc keeps a / 2)
+    after, rest_block, rest_s = task_stops(toolpath, merged_source, source, control)
     parabolic_end = np.zeros(len(moves), bool)
     parabolic_end[after[(after > 0) & (after <= len(moves))] - 1] = True
     parabolic_end[-1] = True
@@ -692,5 +693,5 @@ def blend_planner(
         t[keep] += np.append(limit == 0, True) * (0.5 * control.period_s)
     move_t = t[0::2] + np.concatenate([[0.0], t[1::2] / 2]) + np.concatenate([t[1::2] / 2, [0.0]])
     block_t = np.bincount(merged_source[source], weights=move_t, minlength=len(toolpath))
-    block_t += toolpath.dwell_s
+    block_t += toolpath.dwell_s + np.bincount(rest_block, rest_s, minlength=len(toolpath))
     return Estimate("planner", machine.name, block_t, toolpath)

@@ -92,7 +92,9 @@ Two readers
 ``"linuxcnc"``. ``"native"`` is the reader above. ``"linuxcnc"`` runs the program through
 LinuxCNC's own rs274ngc interpreter (``make linuxcnc`` installs it; see
 :mod:`nctwin.gcode._interp`), which reads the whole language and gives the moves LinuxCNC runs,
-as the same :class:`~nctwin.toolpath.Toolpath`; it takes a LinuxCNC tool table
+as the same :class:`~nctwin.toolpath.Toolpath` (its G5/G5.1 splines as the biarcs LinuxCNC's
+task runs, :mod:`nctwin.gcode._splines`, not the preview's lines; M, S and T words are not
+kept); it takes a LinuxCNC tool table
 (``tool_table=``, default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC
 configuration); a tool the table lacks runs with size 0 unless the program's cutter
 compensation or length offset needs its size (:func:`complete_tool_table`). ``"auto"`` is the

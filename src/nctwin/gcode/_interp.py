@@ -46,6 +46,9 @@ units, planes, offsets. Its canonical moves are turned into the same
   interpreter runs ``G64 P987654321 Q987654321``, a sentinel: a block in that state is in
   :attr:`~nctwin.toolpath.PathMode.DEFAULT` mode, as the native reader marks blocks before any
   G61/G64.
+* Splines: the module draws a G5 or G5.1 as straight lines, where LinuxCNC's task runs biarcs;
+  :mod:`nctwin.gcode._splines` puts the task's moves in their place (G5.2/G5.3 NURBS stay
+  the module's lines).
 * Canned cycles: LinuxCNC runs their moves in exact-path mode (but a first rapid up to R from
   below it); the module does not report that switch, so those blocks are marked here, as the
   native reader marks them.
@@ -91,6 +94,7 @@ import numpy as np
 from ..toolpath import PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
 from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
+from ._splines import task_splines
 
 #: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -530,6 +534,7 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     """The canonical moves as a Toolpath (mm, mm/s, machine coordinates)."""
     if not len(moves):
         return Toolpath.empty()
+    moves, events, modal = task_splines(moves, events, modal, source)
     kind = moves[:, 0].astype(np.int8)
     index = np.arange(len(moves))
     # the event and modal record of each move: the last one made before it

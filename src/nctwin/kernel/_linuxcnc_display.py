@@ -103,6 +103,8 @@ def run(folder):
                 stat.poll()
                 if stat.queue_full or (stat.queue > 0 and stat.exec_state in WAITING_FOR_MOTION):
                     break
+                if stat.task_paused:  # an M0/M1 before the first move: resumed below
+                    break
                 if started and stat.interp_state == linuxcnc.INTERP_IDLE:
                     break
                 started = started or stat.interp_state != linuxcnc.INTERP_IDLE
@@ -113,6 +115,8 @@ def run(folder):
                 stat.poll()
                 if stat.interp_state == linuxcnc.INTERP_IDLE and stat.queue == 0 and stat.inpos:
                     break
+                if stat.task_paused:  # M0, M1: the operator presses cycle start at once
+                    cmd.auto(linuxcnc.AUTO_RESUME)
                 time.sleep(POLL_S)
             time.sleep(TAIL_S)
             check_errors(errors)

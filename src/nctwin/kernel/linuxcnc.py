@@ -34,7 +34,10 @@ How a run works
   depends on how fast the interpreter ran: traces repeat bit for bit, at any speed-up up to 5
   and on a busy machine. After a queue buster in the middle of a program (a dwell, an M-code that
   waits) the motion restarts as soon as the next move is queued, as on the real control; such
-  programs may not repeat bit for bit. This module only writes and reads files, so nctwin
+  programs may not repeat bit for bit. A program pause (``M0``, ``M1``) is resumed at once,
+  as if the operator pressed cycle start (``AUTO_RESUME`` at the display's next poll): the
+  recorded rest after it, 8-10 ms after an ``M0`` and 130-150 ms after an ``M1`` measured, is
+  the recorder's. This module only writes and reads files, so nctwin
   imports without LinuxCNC.
 
 Conventions of the returned motion: ``pos_mm`` is the commanded position (``pos-cmd``), the first

@@ -1,6 +1,7 @@
 r"""Part programs in the whole RS274/NGC language, as a shop's CAM system or a programmer at the
 machine writes them: canned drilling cycles, cutter compensation, subroutines, parameters and
-expressions, offsets and units, arcs and helices outside the XY plane.
+expressions, offsets and units, arcs and helices outside the XY plane, splines, and the tool
+changes, pauses and dwells a control's task waits for.
 
 Paper 1's training programs and the CAM-style programs (:mod:`nctwin.programs.training`,
 :mod:`nctwin.programs.camstyle`) are chains of G1 lines that the native reader reads. A shop's
@@ -339,6 +340,77 @@ M2
 """
 
 
+def splines() -> str:
+    """G5.1 quadratic and G5 cubic splines in the XY plane at 20-60 mm/s, which LinuxCNC's task
+    runs as biarcs: a chain of curves, a straight G5.1 (its control point on the chord), a G5
+    continuing the previous one's end tangent (no I, J), an S and a hook, one in inches."""
+    return """\
+(nctwin language program: G5 and G5.1 splines)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+G0 X0 Y0 Z1
+G1 Z0 F600
+(quadratic splines G5.1: a chain of curves at 20 mm/s)
+G5.1 X20 Y0 I10 J10 F1200
+G5.1 X40 Y0 I10 J-10
+G5.1 X60 Y20 I20 J0
+(a straight G5.1: the control point on the chord)
+G5.1 X80 Y20 I10 J0
+G1 X90
+(cubic splines G5, the second continuing the first's end tangent)
+G5 X110 Y40 I10 J0 P0 Q-10 F2400
+G5 X130 Y20 P10 Q0
+(a wide S and a tight hook at 60 mm/s)
+G5 X100 Y-10 I-20 J-30 P30 Q-10 F3600
+G5.1 X90 Y0 I-10 J-5
+G1 X80 Y0
+(in inches, at 40 in/min)
+G20
+G5.1 X2.5 Y-0.5 I-0.5 J-0.5 F40
+G21 G0 Z5
+M2
+"""
+
+
+def tool_pauses() -> str:
+    """Words LinuxCNC's task runs only once the motion has stopped, between moves: coolant on
+    and off, a program pause (M0), the spindle stopped and started, a tool change with its
+    length offset (``T1 M6 G43 H1``), and the short dwells before rapids of LinuxCNC's
+    skeleton program (``G4 P.001``)."""
+    return """\
+(nctwin language program: tool change, pause, spindle, coolant and dwells between moves)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.05
+G0 X0 Y0 Z10
+S1000 M3
+G1 Z0 F600
+G1 X40 F1800
+(coolant on and off between lines)
+M8
+G1 Y30
+M9
+G1 X0
+(a program pause: the operator's wait is not timed)
+M0
+G1 Y0
+(a tool change with its length offset, the spindle stopped and restarted)
+M5
+G0 Z20
+T1 M6 G43 H1
+G4 P.001 G0 X20 Y20 S2000 M3
+G4 P.001 G0 Z1
+G1 Z0 F600
+G1 X60 Y20 F2400
+G1 X60 Y-10
+(a short dwell before each rapid)
+G4 P.001 G0 Z10
+G4 P.001 G0 X0 Y0
+M5 M9
+G49
+M2
+"""
+
+
 #: Name -> function returning the program's text.
 LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "drill_cycles": drill_cycles,
@@ -347,4 +419,6 @@ LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "parametric_curve": parametric_curve,
     "offsets_units": offsets_units,
     "plane_arcs": plane_arcs,
+    "splines": splines,
+    "tool_pauses": tool_pauses,
 }
