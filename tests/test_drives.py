@@ -95,9 +95,10 @@ def _standing_run(force_n, machine, duration_s=1.0):
 
 def test_standing_axis_under_a_tooth_frequency_force_reads_far_below_the_quantum():
     """200 Hz, 100 N on X and Y (moved masses 250 and 510 kg): a rigid slide would swing at
-    100 / (m 2 pi 200) = 0.32 and 0.16 mm/s, two to six quanta. The ~60 Hz compliance passes
-    1 / ((200/60)^2 - 1) = 0.1 of the force to the slide and the 4 ms mean keeps
-    sin(0.8 pi) / (0.8 pi) = 0.23 of the swing: about 0.008 and 0.004 mm/s, so both read 0."""
+    100 / (m 2 pi 200) = 0.32 and 0.16 mm/s, two to six quanta. The 20 Hz compliance (damping
+    ratio 0.3, frequency ratio 10) passes sqrt(1 + 6^2) / sqrt(99^2 + 6^2) = 0.06 of the force to
+    the slide (190 and 450 kg): 0.026 and 0.011 mm/s; the 4 ms mean keeps
+    sin(0.8 pi) / (0.8 pi) = 0.23 of that, about 0.006 and 0.003 mm/s, so both read 0."""
     exact = drives.FeedDriveMachine(velocity_noise_mm_s=0.0, velocity_resolution_mm_s=0.0)
     rec = _standing_run(lambda t: 100.0 * np.sin(2 * np.pi * 200.0 * t), exact)
     swing = np.abs(rec.vel_mm_s[0, 50:, :2]).max(axis=0)
