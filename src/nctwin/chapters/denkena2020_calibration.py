@@ -18,7 +18,33 @@ from ..physics import drives
 from .denkena2020 import fit_force_model, reconstruct
 from .denkena2020_bench import TOOL, Process, process_windows, run_air_moves, run_processes
 
-__all__ = ["calibrate_bench", "calibration_processes", "with_compliance"]
+__all__ = [
+    "CANDIDATES",
+    "calibrate_bench",
+    "calibration_processes",
+    "paper_ramp",
+    "with_compliance",
+]
+
+#: The compliances tried, ``(mass_kg, stiffness_n_mm, damping_ratio)``: corners of 16 and 20 Hz
+#: (below the spindle frequencies of Table 1), damping ratios of 0.1 and 0.3; the last is the one
+#: frozen in :mod:`nctwin.physics.drives`.
+CANDIDATES = ((60.0, 606.0, 0.3), (60.0, 947.0, 0.1), (60.0, 947.0, 0.3))
+
+
+def paper_ramp(paper2: pd.DataFrame) -> dict:
+    """The paper's ramp row of Table 2 as a process (its largest depth as ``ap_mm``), for
+    :func:`nctwin.chapters.denkena2020.design_processes` (``paper_test``).
+
+    Parameters
+    ----------
+    paper2 : pandas.DataFrame
+        The paper table ``denkena2020_table2``.
+    """
+    row = paper2[paper2["process"] == "ramp milling"].iloc[0]
+    return {"kind": "ramp", "feed_direction": str(row["feed_direction"]),
+            "ae_mm": float(row["ae_mm"]), "ap_mm": float(row["ap_max_mm"]),
+            "vf_mm_min": float(row["feed_mm_min"]), "n_rpm": float(row["spindle_rpm"])}  # fmt: skip
 
 
 def calibration_processes(
@@ -40,12 +66,10 @@ def calibration_processes(
     list of Process
         Indices 0 (ramp), 1-3 (grooves ``+x+y``, ``-x-y``, ``+x-y``).
     """
-    row = paper2[paper2["process"] == "ramp milling"].iloc[0]
-    vf = float(row["feed_mm_min"])
-    half = 0.5 * vf / 60.0 * (duration_s - 0.6)
-    procs = [Process(0, "ramp", str(row["feed_direction"]), float(row["ae_mm"]),
-                     float(row["ap_max_mm"]), vf, float(row["spindle_rpm"]),
-                     (150.0, 150.0 + half, 100.0), False, 0.0, 0.0, True)]  # fmt: skip
+    q = paper_ramp(paper2)
+    half = 0.5 * q["vf_mm_min"] / 60.0 * (duration_s - 0.6)
+    procs = [Process(0, "ramp", q["feed_direction"], q["ae_mm"], q["ap_mm"], q["vf_mm_min"],
+                     q["n_rpm"], (150.0, 150.0 + half, 100.0), False, 0.0, 0.0, True)]  # fmt: skip
     ap = grid["ap_mm"][len(grid["ap_mm"]) // 2]
     for k, direction in enumerate(("+x+y", "-x-y", "+x-y")):
         vf = grid["vf_mm_min"][[0, 2, -1][k]]

@@ -83,9 +83,9 @@ __all__ = [
 #: frequencies of Table 1, so runout and tooth passing do not shake the slide. Fixed before any
 #: LSTM was trained, from the model's errors the paper publishes about its bench (Table 2's ramp
 #: row, X and Y; the grooves of Figs. 4-5), by
-#: :func:`nctwin.chapters.denkena2020_calibration.calibrate_bench`: among corners of 12-20 Hz
-#: and damping ratios of 0.03-0.3 on 60 kg, this one puts the ramp's X error nearest the
-#: paper's, with Y and the grooves inside their bands.
+#: :func:`nctwin.chapters.denkena2020_calibration.calibrate_bench`: of the ``CANDIDATES`` there
+#: (60 kg; corners of 16 and 20 Hz, damping ratios of 0.1 and 0.3), this one puts the ramp's X
+#: error nearest the paper's, with Y and the grooves inside their bands.
 COMPLIANCE_MASS_KG = 60.0
 COMPLIANCE_STIFFNESS_N_MM = 947.0
 COMPLIANCE_DAMPING_RATIO = 0.3
