@@ -151,6 +151,12 @@ def test_standing_axis_motion_counts_nonzero_velocity_while_cutting() -> None:
     assert (row.axis, row.samples, row.moving_share_pct) == ("X", 3, 100.0)
     assert row.max_abs_v_mm_s == pytest.approx(0.3)
     assert len(table) == 2 and table.iloc[-1].process == "all"
+    forces = np.zeros((1, 4, 3))
+    recon = {0: np.array([[0.0] * 3, [100.0] * 3, [-100.0] * 3, [0.0] * 3])}
+    with_model = dc.standing_axis_motion(rec, w, [0], 0.05, model=(forces, recon, [100.0] * 3))
+    # two of the three cutting samples off by 100 N; all three read a quantum
+    assert with_model.iloc[0].model_rmse_n == pytest.approx(100.0 * np.sqrt(2 / 3))
+    assert with_model.iloc[0].switch_rmse_n == pytest.approx(100.0)
 
 
 def test_conditions_read_the_paper_and_measure_ours() -> None:
