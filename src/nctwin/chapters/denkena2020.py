@@ -3,9 +3,11 @@ model-based reconstruction.
 
 The chapter's pipeline, kept out of the notebook:
 
-1. :func:`design_processes` draws 181 processes over the Table 1 grid (side and groove milling in
-   eight feed directions, counter-clockwise circular pockets with a plunge, -y/+z ramps), marks
-   a seeded share of the heavy ones semi-stable and splits 160/21 (stratified, seeded).
+1. :func:`design_processes` draws 160 training processes over the Table 1 grid and 21 test
+   processes off it, the paper's ramp row among them (side and groove milling in eight feed
+   directions, counter-clockwise circular pockets with a plunge, -y/+z ramps), and marks a
+   seeded share of the straight cuts semi-stable. The bench's compliance was fixed before, from
+   the model's errors alone (:mod:`nctwin.chapters.denkena2020_calibration`).
 2. :func:`run_processes` (:mod:`nctwin.chapters.denkena2020_bench`, the simulated test bench)
    interpolates each process, computes its milling forces and runs the drives.
 3. :func:`fit_force_model` fits the paper's model (:mod:`nctwin.methods.denkena2020`) on the air
