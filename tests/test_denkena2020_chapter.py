@@ -11,6 +11,7 @@ import pytest
 import torch
 
 from nctwin.chapters import denkena2020 as dk
+from nctwin.chapters import denkena2020_calibration as cal
 from nctwin.chapters import denkena2020_claims as dc
 from nctwin.chapters.denkena2020_bench import _segment
 from nctwin.physics import drives
@@ -31,7 +32,7 @@ def test_segment_travels_its_length_at_its_speed() -> None:
 
 
 def test_semi_stability_is_independent_of_the_load() -> None:
-    procs = dk.design_processes(GRID, seed=0, semi_stable_share=0.5)
+    procs = dk.design_processes(GRID, seed=0, duration_s=13.0, semi_stable_share=0.5)
     straight = pd.DataFrame([vars(p) for p in procs if p.kind in ("side", "groove")])
     load = straight.ap_mm * straight.ae_mm
     semi = straight.semi_stable
@@ -41,11 +42,31 @@ def test_semi_stability_is_independent_of_the_load() -> None:
     assert test.semi_stable.any() and (~test.semi_stable).any()
     assert sum(p.test for p in procs) == 21
     with pytest.raises(ValueError, match="semi_stable_share"):
-        dk.design_processes(GRID, seed=0, semi_stable_share=1.5)
+        dk.design_processes(GRID, seed=0, duration_s=13.0, semi_stable_share=1.5)
+
+
+def test_training_lies_on_the_grid_and_testing_off_it_with_the_paper_ramp() -> None:
+    ramp = cal.paper_ramp(load_paper_table("denkena2020_table2"))
+    procs = dk.design_processes(GRID, seed=0, duration_s=13.0, paper_test=[ramp])
+    keys = ("ae_mm", "ap_mm", "vf_mm_min", "n_rpm")
+    on_grid = [all(getattr(p, k) in GRID[k] for k in keys) for p in procs]
+    assert all(g for g, p in zip(on_grid, procs, strict=True) if not p.test)
+    assert not any(g for g, p in zip(on_grid, procs, strict=True) if p.test)
+    assert sum(p.test for p in procs) == 21 and sum(not p.test for p in procs) == 160
+    first_ramp = next(p for p in procs if p.test and p.kind == "ramp")
+    assert {k: getattr(first_ramp, k) for k in keys} == {k: ramp[k] for k in keys}
+    machine = drives.FeedDriveMachine()
+    w = dk.process_windows(procs[::10], machine, duration_s=13.0)
+    assert w.cutting.shape == (len(procs[::10]), 13 * 250)
+    # every path stays inside the 20-280 mm travel the model's air moves cover
+    for p in procs:
+        u = np.array(dk.DIRECTIONS.get(p.feed_direction, (0.0, -1.0 if p.kind == "ramp" else 0.0)))
+        end = np.array(p.start_mm[:2]) + u * p.vf_mm_min / 60.0 * 12.4
+        assert 20.0 < min(*p.start_mm[:2], *end) and max(*p.start_mm[:2], *end) < 280.0, p
 
 
 def test_windows_of_a_straight_cut_and_a_pocket() -> None:
-    procs = dk.design_processes(GRID, seed=0)
+    procs = dk.design_processes(GRID, seed=0, duration_s=6.0)
     machine = drives.FeedDriveMachine()
     cut_x = next(p for p in procs if p.feed_direction == "+x")
     pocket = next(p for p in procs if p.kind == "pocket")
@@ -64,7 +85,7 @@ def test_windows_of_a_straight_cut_and_a_pocket() -> None:
 
 
 def test_rmse_per_window_by_hand() -> None:
-    procs = dk.design_processes(GRID, seed=0)
+    procs = dk.design_processes(GRID, seed=0, duration_s=6.0)
     p = next(q for q in procs if q.test)
     n = 4
 
@@ -130,6 +151,12 @@ def test_standing_axis_motion_counts_nonzero_velocity_while_cutting() -> None:
     assert (row.axis, row.samples, row.moving_share_pct) == ("X", 3, 100.0)
     assert row.max_abs_v_mm_s == pytest.approx(0.3)
     assert len(table) == 2 and table.iloc[-1].process == "all"
+    forces = np.zeros((1, 4, 3))
+    recon = {0: np.array([[0.0] * 3, [100.0] * 3, [-100.0] * 3, [0.0] * 3])}
+    with_model = dc.standing_axis_motion(rec, w, [0], 0.05, model=(forces, recon, [100.0] * 3))
+    # two of the three cutting samples off by 100 N; all three read a quantum
+    assert with_model.iloc[0].model_rmse_n == pytest.approx(100.0 * np.sqrt(2 / 3))
+    assert with_model.iloc[0].switch_rmse_n == pytest.approx(100.0)
 
 
 def test_conditions_read_the_paper_and_measure_ours() -> None:

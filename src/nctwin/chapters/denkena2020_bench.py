@@ -341,7 +341,7 @@ def run_processes(
         "duration_s": duration_s,
         "seed": seed,
         "batch_size": batch_size,
-        "version": 2,
+        "version": 3,
     }
     path = cache_path("denkena2020", "processes", content_key(key), ".npz")
     if path.exists():
@@ -420,7 +420,7 @@ def run_air_moves(
         "accel": list(accel_speeds_mm_s),
         "accel_mm": accel_mm,
         "duration_s": duration_s,
-        "version": 2,
+        "version": 3,
     }
     path = cache_path("denkena2020", "air", content_key(key), ".npz")
     kinds, speeds, refs = [], [], []
@@ -447,7 +447,7 @@ def run_air_moves(
     pos = np.repeat(np.stack(refs)[:, :, None], 3, axis=2)
     if path.exists():
         with np.load(path) as d:
-            rec = drives.DriveRecord(d["t_s"], d["pos"], d["vel"], d["acc"], d["cur"])
+            rec = drives.DriveRecord(d["t_s"], d["pos"], d["vel"], d["acc"], d["cur"], d["dfl"])
     else:
         vel = np.gradient(pos, dt, axis=1)
         acc = np.gradient(vel, dt, axis=1)
@@ -461,6 +461,7 @@ def run_air_moves(
             vel=rec.vel_mm_s,
             acc=rec.acc_mm_s2,
             cur=rec.current_a,
+            dfl=rec.deflection_mm,
         )
     return AirMoves(
         np.array(kinds), np.array(speeds), rec.pos_mm, rec.vel_mm_s, rec.acc_mm_s2, rec.current_a

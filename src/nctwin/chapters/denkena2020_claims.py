@@ -156,10 +156,15 @@ def standing_axis_motion(
     test: list[int],
     resolution_mm_s: float,
     axes: str = "XY",
+    *,
+    model: tuple[np.ndarray, dict[int, np.ndarray], np.ndarray] | None = None,
 ) -> pd.DataFrame:
     """How a standing axis moves while the tool cuts: for every test process and axis whose
     set point stands still through the cut, the share of cutting samples whose recorded
-    velocity is not zero (at least one quantum of ``resolution_mm_s``) and the largest |v|.
+    velocity is not zero (at least one quantum of ``resolution_mm_s``) and the largest |v|;
+    with ``model``, the model's RMSE over the cut beside what eq. 4's switch alone makes of
+    that share: at :math:`v = 0` its friction is 0, at one quantum about :math:`\\pm F_{br}`,
+    so an RMSE of :math:`F_{br} \\sqrt{\\mathrm{share}}`.
 
     Parameters
     ----------
@@ -170,12 +175,16 @@ def standing_axis_motion(
     resolution_mm_s : float
         The velocity quantum of the recording.
     axes : str
+    model : (ndarray, dict, ndarray), optional
+        Filtered measured forces (P, R, 3), the model's forces per test process (R, 3), and the
+        fitted breakaway forces :math:`F_{br}` of X, Y, Z (3,).
 
     Returns
     -------
     pandas.DataFrame
         One row per standing axis: ``process``, ``feed_direction``, ``axis``, ``samples``,
-        ``moving_share_pct``, ``max_abs_v_mm_s``; and a last row ``all`` pooling the samples.
+        ``moving_share_pct``, ``max_abs_v_mm_s`` (with ``model``: ``model_rmse_n``,
+        ``switch_rmse_n``); and a last row ``all`` pooling the samples.
     """
     rows, moving, total = [], 0, 0
     for p in test:
@@ -192,6 +201,10 @@ def standing_axis_motion(
                          "axis": axis, "samples": len(v),
                          "moving_share_pct": 100.0 * nonzero / len(v),
                          "max_abs_v_mm_s": float(v.max())})  # fmt: skip
+            if model is not None:
+                targets, recon, breakaway = model
+                rows[-1]["model_rmse_n"] = _rmse(recon[p][:, i], targets[p, :, i], cut)
+                rows[-1]["switch_rmse_n"] = float(breakaway[i] * np.sqrt(nonzero / len(v)))
     rows.append(
         {
             "process": "all",
