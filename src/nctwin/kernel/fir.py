@@ -606,7 +606,5 @@ def run(toolpath: Toolpath, machine: Machine, control: FirControl) -> Motion:
     t = np.arange(len(pos), dtype=np.float64)
     t *= ts
     # block of each sample: the command's block at the centre of the filter window
-    block = np.empty(len(pos), dtype=prep.kept.dtype)
-    _fir_loops.sample_blocks(t_knots, ts, lag // 2, cmd.pause_block, cmd.block, prep.kept, 0,
-                             block)  # fmt: skip
+    block = cmd.sample_blocks(t_knots, ts, lag // 2, prep.kept, 0, len(pos))
     return Motion(t, pos, vel, block, ts)
