@@ -247,7 +247,7 @@ def test_kernel_cycle_time_exceeds_cam():
 def test_bad_filter_constants_are_named():
     with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range: allowed \[period_s, 10\]"):
         FirControl(t1_s=0.0, t2_s=0.0)
-    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range for the FIR kernel"):
+    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range: allowed \[0.001, 10\]"):
         fir.FirFilter(0.0, 0.0, 0.001)
 
 
