@@ -168,6 +168,45 @@ def test_rapid_capped_at_the_filters_step_unless_ramped():
         dataclasses.replace(SETTINGS, rapid_ramp=1)
 
 
+def test_many_ramped_rapids_each_climb_their_stairs():
+    # G61: every block from rest to rest. Each 300 mm rapid as the one above (8 stairs, 198 mm at
+    # 500 mm/s, T1 + T2), each 1 mm G1 at 10 mm/s in 0.1 s + T1 + T2: all 120 blocks alike
+    n = 60
+    tp = parse("G61\n" + "\n".join(f"G0 X{300 * (k + 1)}\nG1 Y{k + 1} F600" for k in range(n)))
+    motion = fir.run(tp, RAMP_MACHINE, dataclasses.replace(SETTINGS, rapid_ramp=True))
+    times = block_targets(motion, tp).time_s
+    np.testing.assert_allclose(times[0::2], 8 * 0.051 + 198 / 500 + 0.06, atol=PERIOD_S)
+    np.testing.assert_allclose(times[1::2], 0.1 + 0.06, atol=PERIOD_S)
+
+
+def _command_of_two_moves() -> _fir_command._Command:
+    """10 mm at 1000 mm/s, a 5 ms pause in block 1, 20 mm at 2000 mm/s in block 2."""
+    return _fir_command._Command(
+        cuts=np.array([0.0, 10.0, 30.0]),
+        speed=np.array([1000.0, 2000.0]),
+        block=np.array([0, 2]),
+        pause=np.array([0.0, 0.005, 0.0]),
+        pause_block=np.array([-1, 1, -1]),
+    )
+
+
+def test_command_knot_times_and_sample_blocks():
+    cmd = _command_of_two_moves()
+    # arrival at and departure from each cut: 10 ms, the pause, 10 ms
+    np.testing.assert_allclose(cmd.knot_times(), [0, 0, 0.01, 0.015, 0.025, 0.025], atol=1e-15)
+    halved = cmd.knot_times(np.array([0.5, 1.0]))
+    np.testing.assert_allclose(halved, [0, 0, 0.02, 0.025, 0.035, 0.035], atol=1e-15)
+    # two samples late: the first move owns samples 0-11, the pause 12-16, the second move
+    # 17-26, the last (unowned) pause takes the first pause's (unowned: kept[-1])
+    kept = np.array([3, 5, 7])
+    expected = np.repeat([3, 5, 7, 7], [12, 5, 10, 3])
+    t_knots = cmd.knot_times()
+    np.testing.assert_array_equal(cmd.sample_blocks(t_knots, PERIOD_S, 2, kept, 0, 30), expected)
+    np.testing.assert_array_equal(
+        cmd.sample_blocks(t_knots, PERIOD_S, 2, kept, 13, 10), expected[13:23]
+    )
+
+
 def test_short_segments_on_a_circle_keep_the_feed_high():
     # 1000 segments of 0.1 mm on a circle of radius 20 mm: blended globally
     r, n, feed = 20.0, 1000, 80.0
@@ -208,7 +247,7 @@ def test_kernel_cycle_time_exceeds_cam():
 def test_bad_filter_constants_are_named():
     with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range: allowed \[period_s, 10\]"):
         FirControl(t1_s=0.0, t2_s=0.0)
-    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range for the FIR kernel"):
+    with pytest.raises(ValueError, match=r"t1_s = 0.0 is out of range: allowed \[0.001, 10\]"):
         fir.FirFilter(0.0, 0.0, 0.001)
 
 

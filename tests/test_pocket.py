@@ -129,17 +129,6 @@ def test_bad_parameters_named(kwargs, name):
         pocket_program(**kwargs)
 
 
-def test_corner_zones_are_short_chords_on_the_corner_radius():
-    sharp = np.vstack(pocket_rings())
-    rounded = np.vstack(pocket_rings(corner_radius_mm=0.8))
-    assert len(rounded) > len(sharp)  # the sharp corners became chords
-    # a 90-degree corner rounded with r: the path passes r (sqrt 2 - 1) inside the vertex
-    corner = np.array([230.0 - TOOL_R, TOOL_R])  # the outermost ring's bottom-right corner
-    d = np.linalg.norm(rounded - corner, axis=1).min()
-    assert d == pytest.approx(0.8 * (math.sqrt(2) - 1), abs=0.01)
-    assert np.linalg.norm(sharp - corner, axis=1).min() < 1e-9
-
-
 def test_pocket_stats_by_hand():
     from nctwin.programs.pocket import pocket_stats
 

@@ -12,74 +12,62 @@ import numpy as np
 __all__ = [
     "best_time_s",
     "check_choice",
-    "check_number",
     "check_range",
-    "check_xyz",
     "whole_periods",
 ]
 
 
 def check_range(
-    name: str, value: float, low: float, high: float = np.inf, *, low_open: bool = False
-) -> None:
-    """Raise ValueError naming ``name``, its value and the allowed interval unless
-    ``low <= value <= high`` (``low < value`` with ``low_open``): :func:`check_number` with a
-    closed upper end."""
-    check_number(name, value, low, high, lo_closed=not low_open, hi_closed=True)
-
-
-def check_number(
     name: str,
     value,
-    lo: float,
-    hi: float,
+    low: float,
+    high: float = math.inf,
     *,
-    lo_closed: bool = False,
-    hi_closed: bool = False,
+    low_open: bool = False,
+    high_open: bool = False,
     allow_inf: bool = False,
-) -> None:
-    """Raise ValueError naming ``name``, its value and the allowed interval unless ``value`` is
-    a real number (numpy's too; not a bool, not NaN) in it; ``allow_inf`` also admits ``inf``.
+    xyz: bool = False,
+):
+    """Raise ValueError naming ``name``, its value and the allowed interval, in one line, unless
+    ``value`` is a real number (numpy's too; not a bool, not NaN) with ``low <= value <= high``
+    (``low < value`` with ``low_open``, ``value < high`` with ``high_open``); ``allow_inf`` also
+    admits ``inf``.
 
-    >>> check_number("feed_mm_s", 0.0, 0.0, 1000.0)
+    With ``xyz``, ``value`` is three numbers (X, Y, Z), each checked (named ``name[X]`` ...).
+
+    Returns
+    -------
+    float or tuple of float
+        The value as a float; with ``xyz`` the three values as a tuple of floats.
+
+    >>> check_range("feed_mm_s", 0.0, 0.0, 1000.0, low_open=True)
     Traceback (most recent call last):
     ...
-    ValueError: feed_mm_s = 0.0 is out of range: allowed (0, 1000)
+    ValueError: feed_mm_s = 0.0 is out of range: allowed (0, 1000]
     """
+    if xyz:
+        try:
+            v = tuple(value)
+        except TypeError:
+            v = ()
+        if len(v) != 3:
+            raise ValueError(f"{name} = {value!r} is out of range: allowed three numbers")
+        return tuple(
+            check_range(f"{name}[{axis}]", x, low, high, low_open=low_open, high_open=high_open,
+                        allow_inf=allow_inf)
+            for axis, x in zip("XYZ", v, strict=True)
+        )  # fmt: skip
     ok = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
     ok = ok and not math.isnan(value)
     if ok and not (allow_inf and value == math.inf):
-        ok = (lo <= value if lo_closed else lo < value) and (
-            value <= hi if hi_closed else value < hi
+        ok = (low < value if low_open else low <= value) and (
+            value < high if high_open else value <= high
         )
     if not ok:
-        interval = f"{'[' if lo_closed else '('}{lo:g}, {hi:g}{']' if hi_closed else ')'}"
+        interval = f"{'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
         extra = " or inf" if allow_inf else ""
         raise ValueError(f"{name} = {value!r} is out of range: allowed {interval}{extra}")
-
-
-def check_xyz(
-    name: str,
-    value,
-    lo: float,
-    hi: float,
-    *,
-    lo_closed: bool = False,
-    hi_closed: bool = False,
-    allow_inf: bool = False,
-) -> tuple[float, float, float]:
-    """Three numbers (X, Y, Z), each checked by :func:`check_number` (named ``name[X]`` ...),
-    as a tuple of floats."""
-    try:
-        v = tuple(value)
-    except TypeError:
-        raise ValueError(f"{name} = {value!r} is out of range: allowed three numbers") from None
-    if len(v) != 3:
-        raise ValueError(f"{name} = {value!r} is out of range: allowed three numbers")
-    for axis, x in zip("XYZ", v, strict=True):
-        check_number(f"{name}[{axis}]", x, lo, hi, lo_closed=lo_closed, hi_closed=hi_closed,
-                     allow_inf=allow_inf)  # fmt: skip
-    return tuple(float(x) for x in v)
+    return float(value)
 
 
 def check_choice(name: str, value, allowed: tuple) -> None:

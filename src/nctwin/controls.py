@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .checks import check_choice, check_number, check_xyz, whole_periods
+from .checks import check_choice, check_range, whole_periods
 
 __all__ = [
     "CONTROLS",
@@ -42,11 +42,11 @@ _XYZ = tuple[float, float, float]
 
 
 def _check_period(period_s: float) -> None:
-    check_number("period_s", period_s, 0.0, 0.1, hi_closed=True)
+    check_range("period_s", period_s, 0.0, 0.1, low_open=True)
 
 
 def _check_tolerance(blend_tol_mm: float) -> None:
-    check_number("blend_tol_mm", blend_tol_mm, 0.0, 10.0, lo_closed=True, hi_closed=True)
+    check_range("blend_tol_mm", blend_tol_mm, 0.0, 10.0)
 
 
 @dataclass(frozen=True)
@@ -92,11 +92,10 @@ class FirControl:
         _check_period(self.period_s)
         _check_tolerance(self.blend_tol_mm)
         for name in ("t1_s", "t2_s"):
-            check_number(name, getattr(self, name), 0.0, 10.0, lo_closed=True, hi_closed=True)
-        check_number("acc_scale", self.acc_scale, 0.0, 100.0)
+            check_range(name, getattr(self, name), 0.0, 10.0)
+        check_range("acc_scale", self.acc_scale, 0.0, 100.0, low_open=True, high_open=True)
         if self.blend_ratio != math.inf:
-            check_number("blend_ratio", self.blend_ratio, 0.0, 1.0, hi_closed=True,
-                         allow_inf=True)  # fmt: skip
+            check_range("blend_ratio", self.blend_ratio, 0.0, 1.0, low_open=True, allow_inf=True)
         if not isinstance(self.rapid_ramp, bool):
             raise ValueError(
                 f"rapid_ramp = {self.rapid_ramp!r} is out of range: allowed true, false"
@@ -155,14 +154,15 @@ class AccDecControl:
     def __post_init__(self) -> None:
         _check_period(self.period_s)
         for name in ("cut_time_constant_s", "rapid_time_constant_s", "rapid_bell_s"):
-            check_number(name, getattr(self, name), 0.0, 10.0, lo_closed=True, hi_closed=True)
+            check_range(name, getattr(self, name), 0.0, 10.0)
         check_choice("rapid_type", self.rapid_type, ("linear", "nonlinear"))
-        for name, lo_closed, hi in (
-            ("position_gain_per_s", False, math.inf),
-            ("inposition_width_mm", False, math.inf),
-            ("inposition_time_s", True, 10.0),
+        for name, low_open, hi in (
+            ("position_gain_per_s", True, math.inf),
+            ("inposition_width_mm", True, math.inf),
+            ("inposition_time_s", False, 10.0),
         ):
-            xyz = check_xyz(name, getattr(self, name), 0.0, hi, lo_closed=lo_closed)
+            xyz = check_range(name, getattr(self, name), 0.0, hi, low_open=low_open, high_open=True,
+                              xyz=True)  # fmt: skip
             object.__setattr__(self, name, xyz)
         for name in ("cut_time_constant_s", "rapid_time_constant_s", "rapid_bell_s"):
             self.periods(name)
@@ -298,27 +298,28 @@ class FanucControl:
             raise ValueError(
                 f"rapid_overlap = {self.rapid_overlap!r} is out of range: allowed True, False"
             )
-        # name: (lo, hi, lo closed, hi closed)
+        # name: (lo, hi, lo open, hi open)
         ranges = {
-            "cut_time_constant_s": (0.0, 10.0, False, True),
-            "rapid_time_constant_s": (0.0, 10.0, False, True),
-            "rapid_bell_s": (0.0, 10.0, True, True),
-            "least_increment_mm": (0.0, 0.1, False, True),
-            "rapid_overlap_percent": (0.0, 100.0, True, True),
-            "arc_radial_acc_mm_s2": (0.0, math.inf, False, True),
-            "block_time_s": (0.0, 1.0, True, False),
-            "feedforward": (0.0, 1.0, True, True),
+            "cut_time_constant_s": (0.0, 10.0, True, False),
+            "rapid_time_constant_s": (0.0, 10.0, True, False),
+            "rapid_bell_s": (0.0, 10.0, False, False),
+            "least_increment_mm": (0.0, 0.1, True, False),
+            "rapid_overlap_percent": (0.0, 100.0, False, False),
+            "arc_radial_acc_mm_s2": (0.0, math.inf, True, False),
+            "block_time_s": (0.0, 1.0, False, True),
+            "feedforward": (0.0, 1.0, False, False),
         }
-        for name, (lo, hi, lo_closed, hi_closed) in ranges.items():
-            check_number(name, getattr(self, name), lo, hi, lo_closed=lo_closed,
-                         hi_closed=hi_closed)  # fmt: skip
-        for name, hi, hi_closed in (
-            ("position_gain_per_s", 1000.0, False),
-            ("natural_freq_hz", 1000.0, False),
-            ("damping", 10.0, True),
-            ("inposition_width_mm", 10.0, True),
+        for name, (lo, hi, low_open, high_open) in ranges.items():
+            check_range(name, getattr(self, name), lo, hi, low_open=low_open, high_open=high_open)
+        for name, hi, high_open in (
+            ("position_gain_per_s", 1000.0, True),
+            ("natural_freq_hz", 1000.0, True),
+            ("damping", 10.0, False),
+            ("inposition_width_mm", 10.0, False),
         ):
-            xyz = check_xyz(name, getattr(self, name), 0.0, hi, hi_closed=hi_closed)
+            xyz = check_range(
+                name, getattr(self, name), 0.0, hi, low_open=True, high_open=high_open, xyz=True
+            )
             object.__setattr__(self, name, xyz)
         k_cut = self.periods("cut_time_constant_s")
         for name in ("rapid_time_constant_s", "rapid_bell_s"):
@@ -373,7 +374,7 @@ class PlannerControl:
                 f"word_stops = {self.word_stops!r} is not allowed: allowed True, False"
             )
         for name in ("dwell_wait_s", "spindle_wait_s", "coolant_wait_s", "tool_change_wait_s"):
-            check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
+            check_range(name, getattr(self, name), 0.0, 600.0)
 
 
 @dataclass(frozen=True)
@@ -411,13 +412,11 @@ class SequenceControl:
 
     def __post_init__(self) -> None:
         for name in ("tool_change_s", "optional_stop_s", "program_start_s", "program_end_s"):
-            check_number(name, getattr(self, name), 0.0, 600.0, lo_closed=True, hi_closed=True)
+            check_range(name, getattr(self, name), 0.0, 600.0)
         if self.first_tool_change_s is not None:
-            check_number("first_tool_change_s", self.first_tool_change_s, 0.0, 600.0,
-                         lo_closed=True, hi_closed=True)  # fmt: skip
+            check_range("first_tool_change_s", self.first_tool_change_s, 0.0, 600.0)
         for name in ("spindle_start_s", "spindle_start_s_per_krpm"):
-            check_number(name, getattr(self, name), -600.0, 600.0, lo_closed=True,
-                         hi_closed=True)  # fmt: skip
+            check_range(name, getattr(self, name), -600.0, 600.0)
 
     def tool_change_at_s(self, first: bool) -> float:
         """The time (s) of a tool change, ``first``: before the program's first spindle

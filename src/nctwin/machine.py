@@ -33,7 +33,7 @@ from dataclasses import MISSING, dataclass, fields
 from datetime import date
 from pathlib import Path
 
-from .checks import check_choice, check_number, check_xyz
+from .checks import check_choice, check_range
 from .controls import (
     CONTROLS,
     AccDecControl,
@@ -117,12 +117,18 @@ class Machine:
         if not isinstance(self.description, str):
             raise ValueError(f"description = {self.description!r} is out of range: allowed text")
         for name in ("axis_max_velocity_mm_s", "axis_max_acceleration_mm_s2"):
-            object.__setattr__(self, name, check_xyz(name, getattr(self, name), 0.0, math.inf))
-        jerk = check_xyz("axis_max_jerk_mm_s3", self.axis_max_jerk_mm_s3, 0.0, math.inf,
-                         allow_inf=True)  # fmt: skip
+            xyz = check_range(name, getattr(self, name), 0.0, math.inf, low_open=True,
+                              high_open=True, xyz=True)  # fmt: skip
+            object.__setattr__(self, name, xyz)
+        jerk = check_range("axis_max_jerk_mm_s3", self.axis_max_jerk_mm_s3, 0.0, math.inf,
+                           low_open=True, high_open=True, allow_inf=True, xyz=True)  # fmt: skip
         object.__setattr__(self, "axis_max_jerk_mm_s3", jerk)
-        check_number("rapid_feed_mm_s", self.rapid_feed_mm_s, 0.0, math.inf)
-        check_number("max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf)
+        check_range(
+            "rapid_feed_mm_s", self.rapid_feed_mm_s, 0.0, math.inf, low_open=True, high_open=True
+        )
+        check_range(
+            "max_feed_mm_s", self.max_feed_mm_s, 0.0, math.inf, low_open=True, high_open=True
+        )
 
 
 @dataclass(frozen=True)

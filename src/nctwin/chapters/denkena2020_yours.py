@@ -31,7 +31,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from ..checks import check_number
+from ..checks import check_range
 from ..learn.train import Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
@@ -153,12 +153,12 @@ def process_fields(spec: Mapping | str) -> dict:
 
 
 def _errors(checks: list[tuple]) -> list[str]:
-    """The messages of the failing :func:`~nctwin.checks.check_number` calls, each given as
-    ``(name, value, lo, hi, keywords)``."""
+    """The messages of the failing :func:`~nctwin.checks.check_range` calls (open at ``lo``),
+    each given as ``(name, value, lo, hi, keywords)``."""
     out = []
     for name, value, lo, hi, keywords in checks:
         try:
-            check_number(name, value, lo, hi, **keywords)
+            check_range(name, value, lo, hi, low_open=True, **keywords)
         except ValueError as exc:
             out.append(str(exc))
     return out
@@ -248,13 +248,13 @@ def make_process(
     if kind == "groove" and ae != d:
         errors.append(f"ae_mm = {ae!r}: allowed {d:g} for a groove (the tool's diameter)")
     elif kind != "groove":
-        checks.append(("ae_mm", ae, 0.0, d, {"hi_closed": kind != "side"}))
+        checks.append(("ae_mm", ae, 0.0, d, {"high_open": kind == "side"}))
     n_max = 60.0 * machine.servo_rate_hz / (2 * TOOL.teeth)
     errors += _errors([
         *checks,
-        ("ap_mm", f["ap_mm"], 0.0, FLUTE_LENGTH_MM, {"hi_closed": True}),
-        ("vf_mm_min", f["vf_mm_min"], 0.0, math.inf, {}),
-        ("n_rpm", f["n_rpm"], 0.0, n_max, {"hi_closed": True}),
+        ("ap_mm", f["ap_mm"], 0.0, FLUTE_LENGTH_MM, {}),
+        ("vf_mm_min", f["vf_mm_min"], 0.0, math.inf, {"high_open": True}),
+        ("n_rpm", f["n_rpm"], 0.0, n_max, {}),
     ])  # fmt: skip
     if errors:
         raise ValueError("\n".join(errors))

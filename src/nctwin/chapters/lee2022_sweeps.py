@@ -23,6 +23,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..checks import check_range
 from ..controls import AccDecControl, FanucControl
 from ..estimate.block_overlap import block_overlap
 from ..kernel import fanuc
@@ -98,15 +99,6 @@ def feed_variants(name: str, seed: int, feeds_mm_min: dict[str, float]) -> dict[
     return out
 
 
-def _check(name: str, values: tuple[float, ...], lo: float, hi: float, lo_open: bool) -> None:
-    """One ValueError line for the first value of ``values`` outside its range."""
-    for v in values:
-        if not (v > lo if lo_open else v >= lo) or not v <= hi:
-            raise ValueError(
-                f"{name} = {v!r} is out of range: allowed {'(' if lo_open else '['}{lo:g}, {hi:g}]"
-            )
-
-
 def sweep_table(
     programs: dict[str, Toolpath],
     machine: Machine,
@@ -151,8 +143,10 @@ def sweep_table(
     ValueError
         For a value out of its range.
     """
-    _check("arc_clamps_mm_s2", tuple(arc_clamps_mm_s2), 0.0, math.inf, True)
-    _check("block_times_s", tuple(block_times_s), 0.0, 1.0, False)
+    for v in arc_clamps_mm_s2:
+        check_range("arc_clamps_mm_s2", v, 0.0, math.inf, low_open=True)
+    for v in block_times_s:
+        check_range("block_times_s", v, 0.0, 1.0)
     runs = [("arc clamp", {"arc_radial_acc_mm_s2": float(a)}) for a in arc_clamps_mm_s2]
     runs += [("block time", {"block_time_s": float(b)}) for b in block_times_s]
     rows = []

@@ -44,7 +44,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..checks import check_number
+from ..checks import check_range
 from ..controls import SequenceControl
 from ..machine import Profile
 from ..toolpath import MotionKind, Toolpath
@@ -221,7 +221,7 @@ def apply_overrides(
     """
     for name, pct in (("rapid_override_pct", rapid_override_pct),
                       ("feed_override_pct", feed_override_pct)):  # fmt: skip
-        check_number(name, pct, 0.0, OVERRIDE_MAX_PCT, hi_closed=True)
+        check_range(name, pct, 0.0, OVERRIDE_MAX_PCT, low_open=True)
     if rapid_override_pct != 100.0:
         rapid = profile.machine.rapid_feed_mm_s * rapid_override_pct / 100.0
         profile = replace(profile, machine=replace(profile.machine, rapid_feed_mm_s=rapid))

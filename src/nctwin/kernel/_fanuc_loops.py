@@ -5,13 +5,14 @@ periods, from the blocks' planned feeds to the servo's measured positions
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from ..toolpath import MotionKind
 
-__all__ = ["control_loop"]
+__all__ = ["Blocks", "Outputs", "Settings", "control_loop"]
 
 _RAPID, _DWELL = int(MotionKind.RAPID), int(MotionKind.DWELL)
 _NEXT, _CUT, _DRAIN_CUT, _RAPIDS, _DRAIN_RAPID, _INPOS, _PAUSE, _DONE = range(8)
@@ -50,18 +51,117 @@ def _box(total, buf, at, a, x, k):  # pragma: no cover - compiled
     return total[a] / k
 
 
-# fmt: off
+class Blocks(NamedTuple):
+    """The N blocks as the loop reads them (:func:`nctwin.kernel.fanuc.simulate` makes them).
+
+    Parameters
+    ----------
+    kind : ndarray of int64, shape (N,)
+        :class:`~nctwin.toolpath.MotionKind` of each block.
+    start, end : ndarray, shape (N, 3)
+        Start and end points (C-contiguous).
+    cut_steps : ndarray, shape (P, 3)
+        The cutting blocks' interpolated position steps, period by period.
+    cut_off : ndarray of int64, shape (N + 1,)
+        Each block's first row of ``cut_steps``.
+    drain_after, stop_after : ndarray of bool, shape (N,)
+        Whether the filters empty after the block; whether the axes also settle in position.
+    pause_n : ndarray of int64, shape (N,)
+        Dwell of each block in periods.
+    """
+
+    kind: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    cut_steps: np.ndarray
+    cut_off: np.ndarray
+    drain_after: np.ndarray
+    stop_after: np.ndarray
+    pause_n: np.ndarray
+
+
+class Settings(NamedTuple):
+    """The control's settings in the loop's units (periods, mm, mm/s).
+
+    Parameters
+    ----------
+    ti : float
+        Interpolation period (s).
+    rapid_feed : float
+        Rapid feed (mm/s).
+    k_rapid, k_bell : int
+        Rapid acc/dec and its bell filter, in periods.
+    linear_rapid : bool
+        Linear-interpolation-type rapids (else each axis at its own rapid feed).
+    overlap : bool
+        Rapid overlap: the next rapid starts once the last has braked to ``overlap_feed``.
+    overlap_feed : float
+        Path speed (mm/s) at which a rapid may overlap the next.
+    exp_cut : bool
+        Exponential cutting acc/dec (else two moving averages).
+    k1, k2 : int
+        Lengths of the two cutting moving averages, in periods.
+    exp_keep, exp_gain : float
+        Exponential filter: share kept per period, and gain.
+    unit : float
+        Least increment (mm): the exponential filter is empty below it.
+    ad : ndarray, shape (3, 2, 2)
+        Each axis's discretised servo state matrix.
+    bd : ndarray, shape (3, 2)
+        Each axis's discretised servo input vector.
+    width : ndarray, shape (3,)
+        In-position widths (mm).
+    """
+
+    ti: float
+    rapid_feed: float
+    k_rapid: int
+    k_bell: int
+    linear_rapid: bool
+    overlap: bool
+    overlap_feed: float
+    exp_cut: bool
+    k1: int
+    k2: int
+    exp_keep: float
+    exp_gain: float
+    unit: float
+    ad: np.ndarray
+    bd: np.ndarray
+    width: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """Arrays the loop writes (capacity C samples, N blocks).
+
+    Parameters
+    ----------
+    cmd, pos : ndarray, shape (C, 3)
+        Commanded and measured positions.
+    blk : ndarray of int64, shape (C,)
+        Block of each sample.
+    wait : ndarray, shape (N,)
+        In-position wait after each block (s), zeros to start with.
+    end : ndarray, shape (N,)
+        Time at which each block's command ends (s), NaN to start with.
+    """
+
+    cmd: np.ndarray
+    pos: np.ndarray
+    blk: np.ndarray
+    wait: np.ndarray
+    end: np.ndarray
+
+
 @njit(cache=True)
-def control_loop(
-    kind, start, end, cut_steps, cut_off, drain_after, stop_after, pause_n,
-    ti, rapid_feed, k_rapid, k_bell, linear_rapid, overlap, overlap_feed,
-    exp_cut, k1, k2, exp_keep, exp_gain, unit,
-    ad, bd, width,
-    cmd_out, pos_out, blk_out, wait_out, end_out,
-):  # pragma: no cover - compiled
-    """Run the control period by period; see :func:`simulate`. Returns the number of samples
-    written, or -1 if the output arrays (capacity ``len(blk_out)``) are too short."""
-    # fmt: on
+def control_loop(blocks, settings, out):  # pragma: no cover - compiled
+    """Run the control period by period (:class:`Blocks`, :class:`Settings`, into
+    :class:`Outputs`); see :func:`nctwin.kernel.fanuc.simulate`. Returns the number of samples
+    written, or -1 if the output arrays (capacity ``len(out.blk)``) are too short."""
+    kind, start, end, cut_steps, cut_off, drain_after, stop_after, pause_n = blocks
+    (ti, rapid_feed, k_rapid, k_bell, linear_rapid, overlap, overlap_feed, exp_cut, k1, k2,
+     exp_keep, exp_gain, unit, ad, bd, width) = settings  # fmt: skip
+    cmd_out, pos_out, blk_out, wait_out, end_out = out
     n_blocks = len(kind)
     cap = len(blk_out)
     buf1 = np.zeros((k1, 3))  # cutting acc/dec: two moving averages

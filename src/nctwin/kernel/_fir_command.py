@@ -55,9 +55,32 @@ class _Command:
         """Time knots (2C,) of the command, speeds multiplied by ``scale``: arrival at and
         departure from each cut, whose arc length is :attr:`knot_s`."""
         speed = self.speed if scale is None else self.speed * scale
+        arrive = np.empty(len(self.cuts))
+        arrive[0] = 0.0
+        np.cumsum(np.diff(self.cuts) / speed, out=arrive[1:])  # moving, then the pauses before
+        arrive[1:] += np.cumsum(self.pause[:-1])
         knots = np.empty(2 * len(self.cuts))
-        _fir_loops.knot_times(self.cuts, speed, self.pause, knots)
+        knots[0::2] = arrive
+        knots[1::2] = arrive + self.pause
         return knots
+
+    def sample_blocks(
+        self, t_knots: np.ndarray, period_s: float, delay: int, kept: np.ndarray, i0: int, n: int
+    ) -> np.ndarray:
+        """Block of samples ``i0 <= i < i0 + n``, shape (n,): ``kept`` (M,) of the command's
+        block at the time segment ``delay`` samples before.
+
+        ``t_knots`` (2C,) from :meth:`knot_times`: segment ``2c`` is the pause at cut ``c``, in
+        ``pause_block[c]``, or where that is -1 the next segment's (the last pause's: the first
+        segment's); segment ``2c + 1`` the move after it, in ``block[c]``. A segment owns the
+        samples from the first at or after its start (1e-9 periods of slack), ``delay`` on, up to
+        the next segment's; the first segment every sample before that too.
+        """
+        seg = np.column_stack([self.pause_block, np.append(self.block, 0)]).ravel()[:-1]
+        seg = np.where(seg < 0, np.roll(seg, -1), seg)
+        first = np.ceil(t_knots[1:-1] / period_s - 1e-9).astype(np.int64) + delay
+        edges = np.clip(np.concatenate([[i0], first, [i0 + n]]), i0, i0 + n)
+        return np.repeat(kept[seg], np.diff(edges))
 
     @property
     def knot_s(self) -> np.ndarray:
@@ -110,9 +133,11 @@ def _command(
     speed = p.feed_mm_s[block].copy()
     if zone.any():
         speed = np.minimum(speed, _fir_loops.range_min(len(mid), i_lo, i_hi, v[zone]))
-    for k, args in stairs.items():
-        on = block == k
-        speed[on] = np.minimum(speed[on], fir_rapids.staircase_mm_s(mid[on], *args))
+    # the intervals of a block are a run of ``block`` (non-decreasing, as ``mid`` increases)
+    ks = np.fromiter(stairs, dtype=np.intp, count=len(stairs))
+    lo, hi = np.searchsorted(block, ks, side="left"), np.searchsorted(block, ks, side="right")
+    for k, a, b in zip(ks, lo, hi, strict=True):
+        speed[a:b] = np.minimum(speed[a:b], fir_rapids.staircase_mm_s(mid[a:b], *stairs[k]))
     pause = np.zeros(len(cuts))
     np.add.at(pause, at, p.pause_s)
     # a pause belongs to the dwell it is, else to the block that ends at the stop

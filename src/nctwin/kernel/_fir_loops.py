@@ -1,7 +1,6 @@
 """Compiled loops of the FIR kernel (numba): sampling the command, the box cascade and the
 axis-limit extremes, one pass over the samples each; the look-ahead's filtered path points; the
-minimum over covering ranges that lowers the speed command; the command's time knots and the
-block of each sample.
+minimum over covering ranges that lowers the speed command.
 
 Each loop performs the same floating-point operations, in the same order, as the numpy code it
 replaces (``np.interp``, running sums with ``np.cumsum``, ``np.diff``, ``np.einsum``), or ones
@@ -23,10 +22,8 @@ __all__ = [
     "box_stream",
     "derivative_peaks",
     "filtered_points",
-    "knot_times",
     "limit_ratios",
     "range_min",
-    "sample_blocks",
     "sample_command",
 ]
 
@@ -339,61 +336,3 @@ def range_min(n, lo, hi, value):  # pragma: no cover - compiled
                 skip[c] = hi[r]  # every cell up to hi[r] is painted once this range is done
                 c += 1
     return out
-
-
-@njit(cache=True)
-def knot_times(cuts, speed, pause, out):  # pragma: no cover - compiled
-    """Arrival at and departure from each of C cuts of a speed command, ``out`` (2C,).
-
-    ``cuts`` (C,) increasing arc lengths, ``speed`` (C - 1,) of the intervals between them,
-    ``pause`` (C,) the wait at each cut. Arrival at cut ``k`` is the running sum of the
-    durations ``(cuts[i + 1] - cuts[i]) / speed[i]``, ``i < k``, plus that of the pauses before
-    it, departure the arrival plus its pause: the sums as ``np.cumsum`` forms them (from
-    ``-0.0``, the additive identity, so the first sum is the first term).
-    """
-    moving = -0.0
-    paused = -0.0
-    out[0] = 0.0
-    out[1] = 0.0 + pause[0]
-    for k in range(1, len(cuts)):
-        moving += (cuts[k] - cuts[k - 1]) / speed[k - 1]
-        paused += pause[k - 1]
-        arrive = moving + paused
-        out[2 * k] = arrive
-        out[2 * k + 1] = arrive + pause[k]
-
-
-@njit(cache=True)
-def _first_sample(t, period_s, delay):  # pragma: no cover - compiled
-    """The first sample at or after time ``t`` (1e-9 periods of slack), ``delay`` samples on."""
-    return int(np.ceil(t / period_s - 1e-9)) + delay
-
-
-@njit(cache=True)
-def sample_blocks(  # pragma: no cover - compiled
-    t_knots, period_s, delay, pause_block, block, kept, i0, out
-):
-    """Block of each sample, ``out`` (n,), from the blocks of the time segments between knots.
-
-    ``t_knots`` (2C,) non-decreasing: segment ``2c`` is the pause at cut ``c``, in block
-    ``pause_block[c]`` (C,), or where that is -1 the next segment's (the last pause's: the
-    first segment's); segment ``2c + 1`` the move after it, in ``block[c]`` (C - 1,). A segment
-    owns the samples from its start's :func:`_first_sample` up to the next segment's (the
-    first segment every sample before that too); ``out[i]`` is ``kept`` of sample ``i0 + i``'s
-    block. One walk over samples and segments together.
-    """
-    segments = len(t_knots) - 1
-    s = 0
-    next_start = _first_sample(t_knots[1], period_s, delay) if segments > 1 else 0
-    for i in range(len(out)):
-        while s + 1 < segments and next_start <= i0 + i:
-            s += 1
-            if s + 1 < segments:
-                next_start = _first_sample(t_knots[s + 1], period_s, delay)
-        if s % 2:
-            b = block[s // 2]
-        else:
-            b = pause_block[s // 2]
-            if b < 0:
-                b = block[s // 2] if s + 1 < segments else pause_block[0]
-        out[i] = kept[b]

@@ -337,20 +337,23 @@ def simulate(toolpath: Toolpath, machine: Machine, control: FanucControl = PAPER
         + stops * (tail + 2 * s.rapid_time_constant_s / ti + k_bell + 0.2 / ti)
         + 10
     )
-    start = np.ascontiguousarray(tp.start_mm)
-    end = np.ascontiguousarray(tp.end_mm)
+    blocks = _fanuc_loops.Blocks(
+        kind, np.ascontiguousarray(tp.start_mm), np.ascontiguousarray(tp.end_mm), cut_steps,
+        cut_off, drain_after, stop_after, pause_n.astype(np.int64),
+    )  # fmt: skip
+    settings = _fanuc_loops.Settings(
+        ti, fr, k_rapid, k_bell, s.rapid_type == "linear", s.rapid_overlap,
+        s.rapid_overlap_percent / 100.0 * fr, exp_cut, k1, k2, exp_keep, exp_gain,
+        s.least_increment_mm, ad, bd, width,
+    )  # fmt: skip
     while True:
         cmd = np.empty((cap, 3))
         pos = np.empty((cap, 3))
         blk = np.empty(cap, np.int64)
         wait = np.zeros(n)
         cmd_end = np.full(n, np.nan)
-        count = _fanuc_loops.control_loop(
-            kind, start, end, cut_steps, cut_off, drain_after, stop_after,
-            pause_n.astype(np.int64), ti, fr, k_rapid, k_bell, s.rapid_type == "linear",
-            s.rapid_overlap, s.rapid_overlap_percent / 100.0 * fr, exp_cut, k1, k2, exp_keep,
-            exp_gain, s.least_increment_mm, ad, bd, width, cmd, pos, blk, wait, cmd_end,
-        )  # fmt: skip
+        out = _fanuc_loops.Outputs(cmd, pos, blk, wait, cmd_end)
+        count = _fanuc_loops.control_loop(blocks, settings, out)
         if count > 0:
             break
         cap *= 2

@@ -45,6 +45,7 @@ from functools import lru_cache
 import numpy as np
 
 from .._rows import row_min, row_norm
+from ..checks import check_range
 from ..controls import FirControl
 from ..geometry import PathGeometry
 from ..limits import path_limits
@@ -81,15 +82,9 @@ class FirFilter:
     period_s: float
 
     def __post_init__(self) -> None:
-        if not self.period_s > 0:
-            raise ValueError(f"period_s = {self.period_s!r} is out of range: allowed (0, 0.1]")
-        for name in ("t1_s", "t2_s"):
-            v = getattr(self, name)
-            lo = self.period_s if name == "t1_s" else 0.0
-            if not (lo <= v <= 10.0):
-                raise ValueError(
-                    f"{name} = {v!r} is out of range for the FIR kernel: allowed [{lo:g}, 10]"
-                )
+        check_range("period_s", self.period_s, 0.0, 0.1, low_open=True)
+        check_range("t1_s", self.t1_s, self.period_s, 10.0)
+        check_range("t2_s", self.t2_s, 0.0, 10.0)
 
     @classmethod
     def of(cls, control: FirControl) -> FirFilter:
@@ -606,7 +601,5 @@ def run(toolpath: Toolpath, machine: Machine, control: FirControl) -> Motion:
     t = np.arange(len(pos), dtype=np.float64)
     t *= ts
     # block of each sample: the command's block at the centre of the filter window
-    block = np.empty(len(pos), dtype=prep.kept.dtype)
-    _fir_loops.sample_blocks(t_knots, ts, lag // 2, cmd.pause_block, cmd.block, prep.kept, 0,
-                             block)  # fmt: skip
+    block = cmd.sample_blocks(t_knots, ts, lag // 2, prep.kept, 0, len(pos))
     return Motion(t, pos, vel, block, ts)

@@ -207,9 +207,7 @@ def _junctions(
     start, pos_b, lab_b, trav_b = 0, np.empty((0, 3)), np.empty(0, np.int64), np.empty(0)
     next_k = 1
     for lo, pos in chunks:
-        label = np.empty(len(pos), dtype=np.int64)
-        _fir_loops.sample_blocks(t_knots, ts, lag // 2, prep.cmd.pause_block, prep.cmd.block,
-                                 prep.kept, lo, label)  # fmt: skip
+        label = prep.cmd.sample_blocks(t_knots, ts, lag // 2, prep.kept, lo, len(pos))
         joined = pos if not len(pos_b) else np.vstack([pos_b[-1:], pos])
         steps = np.linalg.norm(np.diff(joined, axis=0), axis=1)
         carry = trav_b[-1] if len(trav_b) else 0.0

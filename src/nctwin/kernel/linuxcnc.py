@@ -63,6 +63,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import check_range
 from ..controls import PlannerControl
 from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, complete_tool_table, dump, parse
 from ..machine import Machine
@@ -285,10 +286,8 @@ class Recording:
 
 
 def _check_run_args(timeout_s: float, speed: float) -> None:
-    if not isinstance(timeout_s, int | float) or not 0 < timeout_s < float("inf"):
-        raise ValueError(f"timeout_s = {timeout_s!r} is out of range: allowed (0, inf)")
-    if not isinstance(speed, int | float) or not 1 <= speed <= 20:
-        raise ValueError(f"speed = {speed!r} is out of range: allowed [1, 20]")
+    check_range("timeout_s", timeout_s, 0.0, float("inf"), low_open=True, high_open=True)
+    check_range("speed", speed, 1.0, 20.0)
 
 
 def record(

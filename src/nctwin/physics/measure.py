@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import check_range
 from ..motion import Motion
 from .servo import PositionLoop
 
@@ -61,10 +62,8 @@ def controller_samples(
         Seed of the jitter.
     """
     period = motion.period_s
-    if not 0 < rate_hz <= 1.0 / period:
-        raise ValueError(f"rate_hz = {rate_hz!r} is out of range: allowed (0, {1 / period:g}]")
-    if not 0 <= jitter_s < 0.5 / rate_hz:
-        raise ValueError(f"jitter_s = {jitter_s!r} is out of range: allowed [0, {0.5 / rate_hz:g})")
+    check_range("rate_hz", rate_hz, 0.0, 1.0 / period, low_open=True)
+    check_range("jitter_s", jitter_s, 0.0, 0.5 / rate_hz, high_open=True)
     rng = np.random.default_rng(seed)
     nominal = np.arange(0.0, motion.cycle_time_s + 1e-12, 1.0 / rate_hz)
     t = nominal + rng.uniform(-jitter_s, jitter_s, len(nominal))

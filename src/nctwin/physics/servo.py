@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
+from ..checks import check_range
+
 __all__ = ["KINDS", "PositionLoop"]
 
 #: Forms of :class:`PositionLoop`.
@@ -57,11 +59,8 @@ class PositionLoop:
         if self.kind not in KINDS:
             raise ValueError(f"kind = {self.kind!r} is not allowed: allowed {', '.join(KINDS)}")
         for name in ("gain_per_s", "natural_freq_hz", "damping"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} = {v!r} is out of range: allowed (0, inf)")
-        if not (isinstance(self.feedforward, int | float) and 0.0 <= self.feedforward <= 1.0):
-            raise ValueError(f"feedforward = {self.feedforward!r} is out of range: allowed [0, 1]")
+            check_range(name, getattr(self, name), 0.0, math.inf, low_open=True, high_open=True)
+        check_range("feedforward", self.feedforward, 0.0, 1.0)
 
     def matrices(self, period_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Exact discretisation for a command velocity held over ``period_s``.

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
+from ..checks import check_range
 from .surfaces import ToolPath
 
 __all__ = [
@@ -136,8 +137,7 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4, max_steps: int = 60) ->
     ValueError
         If ``xtol`` or ``max_steps`` is out of range.
     """
-    if not 0.0 < xtol <= 0.01:
-        raise ValueError(f"xtol = {xtol!r} is out of range: allowed (0, 0.01]")
+    check_range("xtol", xtol, 0.0, 0.01, low_open=True)
     if not max_steps >= 1:
         raise ValueError(f"max_steps = {max_steps!r} is out of range: allowed >= 1")
     seg = path.segments()

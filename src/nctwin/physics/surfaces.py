@@ -35,7 +35,7 @@ from functools import cached_property
 import numpy as np
 from scipy import optimize
 
-from ..checks import check_number
+from ..checks import check_range
 from ..report.tables import load_paper_table
 
 __all__ = [
@@ -81,15 +81,15 @@ class BumpSurface:
 
     def __post_init__(self) -> None:
         for name in ("size_x_mm", "size_y_mm", "size_z_mm"):
-            check_number(name, getattr(self, name), 0.0, np.inf)
+            check_range(name, getattr(self, name), 0.0, np.inf, low_open=True, high_open=True)
         if not self.bumps or any(len(b) != 5 for b in self.bumps):
             raise ValueError(
                 f"bumps = {self.bumps!r} is out of range: allowed a non-empty tuple of "
                 "(x, y, sigma_x, sigma_y, weight)"
             )
         for b in self.bumps:
-            check_number("bump sigma_x", b[2], 0.0, np.inf)
-            check_number("bump sigma_y", b[3], 0.0, np.inf)
+            check_range("bump sigma_x", b[2], 0.0, np.inf, low_open=True, high_open=True)
+            check_range("bump sigma_y", b[3], 0.0, np.inf, low_open=True, high_open=True)
         if all(b[4] == 0 for b in self.bumps):
             raise ValueError(f"bumps = {self.bumps!r} is out of range: allowed a non-zero weight")
 
@@ -222,8 +222,8 @@ class Sphere:
     sweep_rad: float = 1.2
 
     def __post_init__(self) -> None:
-        check_number("radius_mm", self.radius_mm, 0.0, np.inf)
-        check_number("sweep_rad", self.sweep_rad, 0.0, np.inf)
+        check_range("radius_mm", self.radius_mm, 0.0, np.inf, low_open=True, high_open=True)
+        check_range("sweep_rad", self.sweep_rad, 0.0, np.inf, low_open=True, high_open=True)
 
     def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points and unit normals on the tool's side, each shape ``(*u.shape, 3)``."""
@@ -283,9 +283,9 @@ class Cylinder:
     sweep_rad: float = 2.0
 
     def __post_init__(self) -> None:
-        check_number("radius_mm", self.radius_mm, 0.0, np.inf)
-        check_number("length_mm", self.length_mm, 0.0, np.inf)
-        check_number("sweep_rad", self.sweep_rad, 0.0, np.inf)
+        check_range("radius_mm", self.radius_mm, 0.0, np.inf, low_open=True, high_open=True)
+        check_range("length_mm", self.length_mm, 0.0, np.inf, low_open=True, high_open=True)
+        check_range("sweep_rad", self.sweep_rad, 0.0, np.inf, low_open=True, high_open=True)
 
     def point_normal(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points and unit normals on the tool's side, each shape ``(*u.shape, 3)``."""
@@ -522,7 +522,7 @@ def iso_parametric_path(
         raise ValueError(f"n_lines = {n_lines!r} is out of range: allowed >= 1")
     if n_points < 2:
         raise ValueError(f"n_points = {n_points!r} is out of range: allowed >= 2")
-    check_number("tool_radius_mm", tool_radius_mm, 0.0, np.inf)
+    check_range("tool_radius_mm", tool_radius_mm, 0.0, np.inf, low_open=True, high_open=True)
     u = np.linspace(0.0, 1.0, n_points)
     v = np.linspace(0.0, 1.0, n_lines)
     cc, normal = surface.point_normal(*np.meshgrid(u, v))

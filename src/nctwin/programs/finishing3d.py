@@ -106,6 +106,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import check_range
 from ..gcode import parse
 from ..toolpath import MotionKind, Toolpath
 
@@ -174,9 +175,7 @@ class FinishingParams:
             ("steep_angle_deg", 90.0),
             ("lead_radius_mm", 100.0),
         ):
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and not isinstance(v, bool) and 0 < v <= hi):
-                raise ValueError(f"{name} = {v!r} is out of range: allowed (0, {hi:g}]")
+            check_range(name, getattr(self, name), 0.0, hi, low_open=True)
         if not isinstance(self.bumps, int) or isinstance(self.bumps, bool) or self.bumps < 0:
             raise ValueError(f"bumps = {self.bumps!r} is out of range: allowed integers >= 0")
         if self.max_segment_mm < 10 * self.tolerance_mm:

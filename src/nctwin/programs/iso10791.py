@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import check_range
 from ..gcode import parse
 from ..paths import data_dir
 from ..toolpath import Toolpath
@@ -96,11 +97,8 @@ class TestPieceParams:
     def __post_init__(self) -> None:
         for name in ("feed_mm_min", "plunge_feed_mm_min", "tool_radius_mm", "pass_depth_mm",
                      "safe_z_mm"):  # fmt: skip
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and 0 < v < math.inf):
-                raise ValueError(f"{name} = {v!r} is out of range: allowed (0, inf)")
-        if not (isinstance(self.dwell_s, int | float) and 0 <= self.dwell_s < math.inf):
-            raise ValueError(f"dwell_s = {self.dwell_s!r} is out of range: allowed [0, inf)")
+            check_range(name, getattr(self, name), 0.0, math.inf, low_open=True, high_open=True)
+        check_range("dwell_s", self.dwell_s, 0.0, math.inf, high_open=True)
         for name, lo in (("passes", 1), ("repeats", 1), ("bore_segments", 8)):
             v = getattr(self, name)
             if not isinstance(v, int) or v < lo:

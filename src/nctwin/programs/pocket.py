@@ -24,9 +24,6 @@ contour-parallel offsets:
   them (stay-down linking), so the program is one chain of feed moves at one depth.
 * **Arcs** (fillets, the arcs of the island's offsets) are written as chords within
   ``chord_tol_mm`` of the arc, as a CAM post-processor that outputs only G1 does.
-* **Corner zones** (:func:`pocket_rings` only): the sharp corners of every offset are
-  rounded by an arc of ``corner_radius_mm``, as CAM systems smooth the corners of their offsets,
-  so each becomes a few short chords between two long lines that meet them tangentially.
 
 :func:`pocket_stats` gives the statistics of a path; the pockets of Chien et al. (2023)
 Tables 2 and 3 are :mod:`nctwin.programs.band_pocket`.
@@ -100,21 +97,14 @@ def _ring(
     start: np.ndarray,
     chord_tol: float,
     excursions: dict[int, list[np.ndarray]] | None = None,
-    corner_radius: float = 0.0,
 ) -> np.ndarray:
     """Points of a closed counter-clockwise ring, from ``start`` (a point on edge 0 -> 1) around
     and back: straight edges as one segment, fillets as chords within ``chord_tol``. At a sharp
     vertex ``i`` of ``excursions``, the tool cuts those loops (each from and back to its first
-    point) and returns to the vertex. Every other sharp vertex is rounded with an arc of radius
-    ``corner_radius`` (0: left sharp).
+    point) and returns to the vertex.
 
     Raises ValueError where a fillet does not fit on its edges (the offset has collapsed)."""
     m = len(vertices)
-    if corner_radius > 0:
-        rounded = radii == 0
-        if excursions:
-            rounded[[i for i, loops in excursions.items() if loops]] = False
-        radii = np.where(rounded, corner_radius, radii)
     u = _unit(np.roll(vertices, -1, axis=0) - vertices)
     u_in = np.roll(u, 1, axis=0)
     turn = np.arctan2(u_in[:, 0] * u[:, 1] - u_in[:, 1] * u[:, 0], (u_in * u).sum(axis=1))
@@ -172,16 +162,13 @@ def pocket_rings(
     stepover_mm: float = 2.0,
     chord_tol_mm: float = 0.001,
     outline_scale: float = 1.0,
-    corner_radius_mm: float = 0.0,
 ) -> list[np.ndarray]:
     """The tool-centre path of the pocket as closed polylines in cutting order (island and
     outline ring per level, middle out; the first outline ring with the corner loops), each
     shape (n_i, 2).
 
     See the module docstring; the parameters are those of :func:`pocket_program`, and
-    ``outline_scale`` scales the outline, its fillets and the band about the origin, and
-    ``corner_radius_mm`` rounds every sharp corner of a ring with an arc of this radius, as a
-    CAM system smooths the corners of its offsets (0: sharp).
+    ``outline_scale`` scales the outline, its fillets and the band about the origin.
     """
     verts = outline_scale * np.array([p for p, _ in OUTLINE_MM])
     radii = outline_scale * np.array([r for _, r in OUTLINE_MM])
@@ -213,10 +200,10 @@ def pocket_rings(
         if d < half - 0.25 * step:  # the middle level is cut once, by the outline's ring
             poly = _offset(*island, -d)
             start = np.array([x_start, poly[0][0, 1]])
-            rings.append(_ring(*poly, start, chord_tol_mm, None, corner_radius_mm)[::-1])
+            rings.append(_ring(*poly, start, chord_tol_mm)[::-1])
         poly = _offset(verts, radii, d)
         start = np.array([x_start, poly[0][0, 1]])
-        rings.append(_ring(*poly, start, chord_tol_mm, loops if k == 0 else None, corner_radius_mm))
+        rings.append(_ring(*poly, start, chord_tol_mm, loops if k == 0 else None))
     return rings
 
 

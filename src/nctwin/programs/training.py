@@ -240,8 +240,7 @@ def mixed_program(
     str
         G-code text.
     """
-    if not 0.0 <= local_share <= 1.0:
-        raise ValueError(f"local_share = {local_share!r} is out of range: allowed [0, 1]")
+    check_range("local_share", local_share, 0.0, 1.0)
     rng = _rng(seed)
     lengths, turns = _sections(rng, n_lines, local_share=local_share, literal=literal)
     kind = "paper mixed" if literal else "mixed"
