@@ -33,6 +33,7 @@ from pathlib import Path
 __all__ = [
     "cache_dir",
     "data_dir",
+    "linuxcnc_samples_dir",
     "nist_dir",
     "public_programs_dir",
     "repo_root",
@@ -176,6 +177,13 @@ def public_programs_dir() -> Path:
     ``data/programs/public/`` byte for byte under their own licence (GPL, not the MIT code's);
     its README gives each file's origin, licence and SHA-256."""
     return data_dir() / "programs" / "public"
+
+
+def linuxcnc_samples_dir() -> Path:
+    """LinuxCNC's own sample programs (its ``nc_files/``) that nctwin reads and LinuxCNC's
+    simulated mill runs, shipped in ``data/programs/public/samples/`` byte for byte (GPL); the
+    public programs' README gives each file's origin and SHA-256."""
+    return public_programs_dir() / "samples"
 
 
 def nist_dir() -> Path:

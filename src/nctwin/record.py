@@ -24,7 +24,7 @@ from .estimate.cam import cam as estimate_cam
 from .gcode import GCodeError, parse
 from .kernel import linuxcnc
 from .machine import Profile, load_profile
-from .paths import public_programs_dir
+from .paths import linuxcnc_samples_dir, public_programs_dir
 from .programs.camstyle import cam_program
 from .programs.language import LANGUAGE_PROGRAMS
 from .programs.pocket import pocket_program
@@ -251,7 +251,7 @@ PUBLIC_SUFFIXES = (".ngc", ".nc", ".gcode")
 
 
 def _record_public_one(
-    path: Path, profile: Profile, speed: float
+    path: Path, profile: Profile, speed: float, prefix: str
 ) -> RecordedProgram | tuple[str, str]:
     text = path.read_text(encoding="utf-8", errors="replace")
     try:
@@ -260,11 +260,11 @@ def _record_public_one(
         # generous: LinuxCNC takes up to several times the CAM time on short segments
         timeout_s = 120.0 + 20.0 * cam_s / speed
         return record_program(
-            f"public_{path.stem}",
+            f"{prefix}{path.stem}",
             text,
             profile,
             speed=speed,
-            source=f"public/{path.name}",
+            source=f"public/{path.relative_to(public_programs_dir()).as_posix()}",
             timeout_s=timeout_s,
         )
     # LinuxCNCError is a GCodeError
@@ -278,24 +278,29 @@ def record_public(
     *,
     n_jobs: int = 2,
     speed: float = 5,
+    prefix: str = "public_",
 ) -> tuple[list[RecordedProgram], dict[str, str]]:
     """Record every public program in ``folder`` that nctwin and LinuxCNC accept.
 
     Parameters
     ----------
     folder : Path, optional
-        Default :func:`nctwin.paths.public_programs_dir`.
+        Default :func:`nctwin.paths.public_programs_dir`; a folder inside it (such as
+        :func:`nctwin.paths.linuxcnc_samples_dir`) for a set of its own.
     out : Path, optional
         Where to save them; default :func:`recording_dir`.
     n_jobs, speed
         See :func:`record_set`.
+    prefix : str
+        The recordings' names: ``prefix`` and the file's stem (``public_``, or ``sample_`` for
+        LinuxCNC's samples).
 
     Returns
     -------
     recorded : list of RecordedProgram
     rejected : dict
         File name -> the reason nctwin or LinuxCNC gave; also written to
-        ``<out>/public_rejected.json``.
+        ``<out>/<prefix>rejected.json``.
     """
     folder = public_programs_dir() if folder is None else Path(folder)
     out = recording_dir() if out is None else Path(out)
@@ -303,7 +308,7 @@ def record_public(
         raise ValueError(f"{folder} is not a folder of public programs")
     profile = load_profile(MACHINE)
     paths = sorted(p for p in folder.iterdir() if p.suffix in PUBLIC_SUFFIXES)
-    tasks = ((p, profile, speed) for p in paths)
+    tasks = ((p, profile, speed, prefix) for p in paths)
     recorded, rejected = [], {}
     for res in run_tasks(
         _record_public_one, tasks, n_jobs=n_jobs, threads=True, desc="LinuxCNC public"
@@ -313,7 +318,8 @@ def record_public(
             recorded.append(res)
         else:
             rejected[res[0]] = res[1]
-    atomic_write_text(out / PUBLIC_REJECTED, json.dumps(rejected, indent=1, sort_keys=True) + "\n")
+    text = json.dumps(rejected, indent=1, sort_keys=True) + "\n"
+    atomic_write_text(out / PUBLIC_REJECTED.replace("public_", prefix), text)
     return recorded, rejected
 
 
@@ -322,10 +328,11 @@ def main() -> None:
     beside the clone) and print one line per program."""
     recorded = record_set()
     if public_programs_dir().is_dir():
-        public, rejected = record_public()
-        recorded += public
-        for name, reason in rejected.items():
-            print(f"record: {name}: rejected: {reason}")
+        for folder, prefix in ((None, "public_"), (linuxcnc_samples_dir(), "sample_")):
+            public, rejected = record_public(folder, prefix=prefix)
+            recorded += public
+            for name, reason in rejected.items():
+                print(f"record: {name}: rejected: {reason}")
     else:
         print(f"record: {public_programs_dir()} is absent: public programs not re-recorded")
     for rec in recorded:

@@ -314,8 +314,8 @@ def evaluation_programs(
     recordings: dict[str, RecordedProgram], profile: Profile
 ) -> tuple[dict[str, tuple[str, Toolpath, MoveData]], list[str]]:
     """The programs the methods are scored on: the recorded test paths, the programs in the
-    whole language (:mod:`nctwin.programs.language`) and the public programs whose text lies
-    beside the clone.
+    whole language (:mod:`nctwin.programs.language`), and the public programs and LinuxCNC's
+    sample programs whose text lies beside the clone.
 
     Parameters
     ----------
@@ -328,8 +328,8 @@ def evaluation_programs(
     -------
     programs : dict
         ``name -> (set, toolpath, data)``: ``set`` is ``"test paths"`` (names ``test_*``),
-        ``"language"`` (names ``lang_*``) or ``"public"`` (the recording's name without
-        ``public_``); ``data`` is the
+        ``"language"`` (names ``lang_*``), ``"samples"`` (LinuxCNC's own sample programs, names
+        ``sample_*``) or ``"public"`` (the recording's name without ``public_``); ``data`` is the
         :class:`~nctwin.estimate.learned.MoveData` of the program's M moves (features of shape
         (M, 7)) with the recorded cycle time.
     public_absent : list of str
@@ -345,6 +345,8 @@ def evaluation_programs(
             continue
         if name.startswith("lang_"):
             group, text = "language", rec.program
+        elif name.startswith("sample_"):
+            group, text = "samples", public_program_text(rec)
         elif rec.source != "nctwin":
             group, text, name = "public", public_program_text(rec), name.removeprefix("public_")
         else:
@@ -355,7 +357,7 @@ def evaluation_programs(
             data = dataclasses.replace(data, measured_s=rec.cycle_time_s)
             programs[name] = (group, tp, data)
     public_absent = [n for n, r in recordings.items() if r.source != "nctwin"
-                     and n.removeprefix("public_") not in programs]  # fmt: skip
+                     and n.removeprefix("public_") not in programs and n not in programs]  # fmt: skip
     return programs, public_absent
 
 
@@ -371,9 +373,10 @@ def _value(row: pd.Series | None, column: str):
 
 
 #: The sets of every program LinuxCNC runs that is not one of nctwin's training or test sets.
-EVERY_PROGRAM_SETS = ("public", "language")
+EVERY_PROGRAM_SETS = ("public", "samples", "language")
 #: The experiment's design: recordings per set (the recording's name up to its first ``_``).
-DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 8, "public": 14}
+DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 8, "public": 14,
+                 "sample": 13}  # fmt: skip
 #: The claims on the public programs, which need every program's path-control mode known
 #: (condition ``startup_mode_programs`` of :func:`experiment_conditions`).
 PUBLIC_CLAIMS = ("best_median_public", "best_worst_public", "best_beats_cam_public",
@@ -520,7 +523,8 @@ def claims(
     n = len(every)
     claims += [
         Claim("planner_median_every", f"the blend-arc planner: median cycle-time error <= 1 % on "
-              f"every program LinuxCNC runs here ({n}: public and in the whole language)",
+              f"every program LinuxCNC runs here ({n}: public, LinuxCNC's samples and in the "
+              "whole language)",
               every.median() if n else float("nan"), "<=", 1.0),
         Claim("planner_worst_every", f"the blend-arc planner: worst cycle-time error <= 3 % on "
               f"the same {n} programs", every.max() if n else float("nan"), "<=", 3.0),
