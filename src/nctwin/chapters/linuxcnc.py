@@ -357,7 +357,7 @@ def evaluation_programs(
             data = dataclasses.replace(data, measured_s=rec.cycle_time_s)
             programs[name] = (group, tp, data)
     public_absent = [n for n, r in recordings.items() if r.source != "nctwin"
-                     and n.removeprefix("public_") not in programs and n not in programs]  # fmt: skip
+                     and {n, n.removeprefix("public_")}.isdisjoint(programs)]  # fmt: skip
     return programs, public_absent
 
 
