@@ -1,4 +1,4 @@
-"""nctwin.report.html and tables.show: one table per result, HTML for the book, text for nbval."""
+"""nctwin.report.html and display.show: one table per result, HTML for the book, text for nbval."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin.report import tables
+from nctwin.report import display
 from nctwin.report.html import format_value, html_table, short_header
 
 
@@ -72,9 +72,9 @@ def test_html_escapes_and_notes():
 def test_show_text_is_what_print_format_table_prints(monkeypatch):
     shown = []
     monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append((obj, raw)))
-    tables.show(frame())
+    display.show(frame())
     ((obj, raw),) = shown
-    assert raw and obj["text/plain"] == tables.format_table(frame())
+    assert raw and obj["text/plain"] == display.format_table(frame())
     assert obj["text/html"] == html_table(frame())
 
 
@@ -84,8 +84,8 @@ def test_show_paper_keeps_format_paper_table_text(monkeypatch):
     paper = pd.DataFrame(
         {"paper": ["P"] * 2, "table": ["Table 1"] * 2, "x": [1.0, 2.0], "note": ["a", None]}
     )
-    tables.show_paper(paper, "p_table1")
-    assert shown[0]["text/plain"] == tables.format_paper_table(paper, "p_table1")
+    display.show_paper(paper, "p_table1")
+    assert shown[0]["text/plain"] == display.format_paper_table(paper, "p_table1")
     assert "<caption>p_table1 | P | Table 1</caption>" in shown[0]["text/html"]
     assert "<li>a</li>" in shown[0]["text/html"] and "<td>[1]</td>" in shown[0]["text/html"]
 

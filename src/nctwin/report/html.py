@@ -1,7 +1,7 @@
 """Tables as compact HTML for the book.
 
-A chapter shows each result once (:func:`nctwin.report.tables.show`): the book renders the HTML
-written here, nbval compares the plain text of :func:`nctwin.report.tables.format_table`. The
+A chapter shows each result once (:func:`nctwin.report.display.show`): the book renders the HTML
+written here, nbval compares the plain text of :func:`nctwin.report.display.format_table`. The
 HTML fits a page column: short headers with the unit in parentheses (the full column name in the
 header's ``title``), floats rounded to a few significant digits, no index, and the paper's
 columns grouped under one "paper" header with the class ``nctwin-paper`` (styled by
