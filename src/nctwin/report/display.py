@@ -2,8 +2,9 @@
 
 A chapter shows each result once, :func:`show` (a paper's table: :func:`show_paper`): one output
 that carries the HTML the book renders (:func:`nctwin.report.html.html_table`) and the plain text
-nbval compares (:func:`format_table`, :func:`format_paper_table`). The plain text is
-deterministic: the same frame always gives the same text.
+a reader of the executed notebook sees (:func:`format_table`, :func:`format_paper_table`). nbval
+compares both in the cells it checks, so both are deterministic: the same frame always gives the
+same text.
 """
 
 from __future__ import annotations
@@ -80,12 +81,12 @@ def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
 
 
 def show(df: pd.DataFrame, *, digits: int = 4) -> None:
-    """Display a table once: compact HTML in the book, :func:`format_table` text for nbval.
+    """Display a table once: compact HTML in the book, :func:`format_table` text beside it.
 
     One display object carries both forms: ``text/html`` (:func:`nctwin.report.html.html_table`,
     floats to ``digits`` significant digits, the paper's columns grouped), which the book
     renders, and ``text/plain``, exactly the text ``print(format_table(df))`` prints (without
-    its final newline), which nbval compares. A chapter cell calls ``show(table)`` where it
+    its final newline); nbval compares both. A chapter cell calls ``show(table)`` where it
     printed ``format_table(table)`` and displayed the frame.
     """
     from IPython.display import display
