@@ -13,7 +13,7 @@ from matplotlib.path import Path
 
 from nctwin.programs import band_pocket as bp
 from nctwin.programs.pocket import OUTLINE_MM, _offset, _ring, pocket_stats
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 R = 4.0
 STEP = 2.0

@@ -15,7 +15,8 @@ from nctwin.chapters import denkena2020_calibration as cal
 from nctwin.chapters import denkena2020_claims as dc
 from nctwin.chapters.denkena2020_bench import _segment
 from nctwin.physics import drives
-from nctwin.report.tables import Claim, load_paper_table
+from nctwin.report.claims import Claim
+from nctwin.report.papers import load_paper_table
 
 GRID = {k: sorted(g["value"].astype(float))
         for k, g in load_paper_table("denkena2020_table1").groupby("parameter")}  # fmt: skip

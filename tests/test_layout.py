@@ -12,7 +12,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "nctwin"
 
 #: The layers, top first: a module imports only modules of its own layer or the ones above it.
 LAYERS = (
-    ("_rows", "paths", "checks", "runner", "_geometry_loops"),
+    ("_rows", "paths", "checks", "runner", "_geometry_loops", "metrics"),
     ("toolpath", "cache"),
     ("motion", "geometry", "controls", "machine", "limits"),
     ("gcode", "naivecam", "targets"),

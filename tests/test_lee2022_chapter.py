@@ -18,7 +18,7 @@ from nctwin.machine import load_machine, load_profile
 from nctwin.methods.lee2022 import check_program
 from nctwin.paths import data_dir
 from nctwin.recordings import load_recordings
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 PAPER = load_paper_table("lee2022_validation")
 SETS = lee.parameter_sets("fanuc_0i_testbed", PAPER)

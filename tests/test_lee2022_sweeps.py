@@ -14,7 +14,7 @@ from nctwin.chapters import lee2022_sweeps as sw
 from nctwin.kernel import fanuc
 from nctwin.machine import load_machine
 from nctwin.programs.finishing3d import FinishingParams, finishing3d_program
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 SETS = lee.parameter_sets("fanuc_0i_testbed", load_paper_table("lee2022_validation"))
 MACHINE = load_machine("fanuc_0i_testbed")

@@ -13,7 +13,7 @@ from nctwin.chapters import lee2022_testbed as bed
 from nctwin.kernel import fanuc
 from nctwin.machine import load_machine
 from nctwin.programs import iso10791
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 MACHINE = load_machine("fanuc_0i_testbed")
 SETS = lee.parameter_sets("fanuc_0i_testbed", load_paper_table("lee2022_validation"))

@@ -8,14 +8,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin.report.claims import bootstrap_interval, format_claim, report_claims, with_seeds
+from nctwin.report.claims import Claim, bootstrap_interval, format_claim, report_claims, with_seeds
 from nctwin.report.conditions import (
     CONDITION_COLUMNS,
     Condition,
     conditions_table,
     report_conditions,
 )
-from nctwin.report.tables import Claim, format_table, write_claims
+from nctwin.report.display import format_table
+from nctwin.report.results import write_claims
 
 CLAIMS = [
     Claim("a", "first claim", 3.14159, "<=", 3.0),

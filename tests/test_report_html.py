@@ -1,12 +1,14 @@
-"""nctwin.report.html and tables.show: one table per result, HTML for the book, text for nbval."""
+"""nctwin.report.html and display.show: one table per result, HTML for the book, text for nbval."""
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin.report import tables
+from nctwin.report import display
 from nctwin.report.html import format_value, html_table, short_header
 
 
@@ -53,28 +55,47 @@ def frame() -> pd.DataFrame:
 
 def test_html_groups_the_paper_columns():
     page = html_table(frame())
-    assert page.startswith('<div class="nctwin-table"><table>')
-    assert '<th colspan="3"></th><th colspan="1" class="nctwin-paper nctwin-start">' in page
-    assert "paper (Chien et al. 2023, Table 1)" in page  # constant source: in the header
-    assert 'title="paper_bilstm_err_pct">bilstm err (%)</th>' in page
-    assert '<td class="nctwin-num">3.235</td>' in page
-    assert '<td class="nctwin-paper nctwin-start nctwin-num">-</td>' in page
-    assert "<td>True</td>" in page  # booleans are not right-aligned numbers
-    assert "index" not in page and html_table(frame()) == page  # no index, deterministic
+    assert page.startswith('<div class="nctwin-table">\n<style type="text/css">')
+    # the paper's column under one header naming the source (constant: not a column)
+    assert '<th class="col_heading level0 col0" colspan="3"></th>' in page
+    assert '<th class="col_heading level0 col3" >paper (Chien et al. 2023, Table 1)</th>' in page
+    assert "paper_source" not in page
+    # short headers, the full name as their title
+    assert '<span title="paper_bilstm_err_pct">bilstm err (%)</span></th>' in page
+    # the paper's column tinted and ruled off by the table's own rule, and only it
+    table_id = re.search(r'<table id="(T_[0-9a-f]+)">', page).group(1)
+    rule = f"#{table_id} .col3 {{\n  background: var(--nctwin-paper-bg);\n"
+    assert rule + "  border-left: var(--nctwin-paper-rule);\n}" in page
+    assert page.count("var(--nctwin-paper-bg)") == 1
+    # numbers in cells that never break; booleans are not right-aligned numbers
+    assert '<td class="data row0 col1 nctwin-num" >3.235</td>' in page
+    assert '<td class="data row1 col3 nctwin-num" >-</td>' in page
+    assert '<td class="data row0 col2" >True</td>' in page
+    assert "row_heading" not in page  # no index
+
+
+def test_html_is_the_same_for_the_same_table_only():
+    page = html_table(frame())
+    assert html_table(frame()) == page  # the id is derived from the content, not random
+    other = frame().assign(bilstm_err_pct=[3.2345678, 2.5])
+    ids = {re.search(r'<table id="(T_[0-9a-f]+)">', p).group(1) for p in (page, html_table(other))}
+    assert len(ids) == 2  # two tables on one page keep their own style rules
 
 
 def test_html_escapes_and_notes():
     page = html_table(pd.DataFrame({"a<b": ["x & y"]}), prefix="", caption="T | 1", notes=["n"])
     assert "a&lt;b" in page and "x &amp; y" in page and "<caption>T | 1</caption>" in page
     assert '<ol class="nctwin-notes"><li>n</li></ol>' in page
+    assert "<caption>a&lt;b</caption>" in html_table(frame(), caption="a<b")
+    assert "level1" not in page  # no paper column: one header row
 
 
 def test_show_text_is_what_print_format_table_prints(monkeypatch):
     shown = []
     monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append((obj, raw)))
-    tables.show(frame())
+    display.show(frame())
     ((obj, raw),) = shown
-    assert raw and obj["text/plain"] == tables.format_table(frame())
+    assert raw and obj["text/plain"] == display.format_table(frame())
     assert obj["text/html"] == html_table(frame())
 
 
@@ -84,10 +105,11 @@ def test_show_paper_keeps_format_paper_table_text(monkeypatch):
     paper = pd.DataFrame(
         {"paper": ["P"] * 2, "table": ["Table 1"] * 2, "x": [1.0, 2.0], "note": ["a", None]}
     )
-    tables.show_paper(paper, "p_table1")
-    assert shown[0]["text/plain"] == tables.format_paper_table(paper, "p_table1")
-    assert "<caption>p_table1 | P | Table 1</caption>" in shown[0]["text/html"]
-    assert "<li>a</li>" in shown[0]["text/html"] and "<td>[1]</td>" in shown[0]["text/html"]
+    display.show_paper(paper, "p_table1")
+    assert shown[0]["text/plain"] == display.format_paper_table(paper, "p_table1")
+    page = shown[0]["text/html"]
+    assert "<caption>p_table1 | P | Table 1</caption>" in page
+    assert "<li>a</li>" in page and '<td class="data row0 col1" >[1]</td>' in page
 
 
 def test_wide_short_tables_are_transposed():
@@ -95,13 +117,17 @@ def test_wide_short_tables_are_transposed():
         {f"c{i}_mm": [1.0 * i, 2.0 * i] for i in range(12)} | {"paper_c1_mm": [1.0, 2.0]}
     )
     page = html_table(wide)
-    assert '<thead><tr><th title="c0_mm">c0 (mm)</th><th>0</th><th>0</th></tr></thead>' in page
-    assert (
-        '<tr class="nctwin-paper nctwin-start-row"><th title="paper_c1_mm">c1 (mm) (paper)</th>'
-        in page
+    head = (
+        '<th class="index_name level0" ><span title="c0_mm">c0 (mm)</span></th>\n'
+        '      <th class="col_heading level0 col0" >0</th>\n'
+        '      <th class="col_heading level0 col1" >0</th>\n    </tr>\n  </thead>'
     )
+    assert head in page
+    label = '<th class="row_heading level0 row11" ><span title="paper_c1_mm">c1 (mm) (paper)</span>'
+    assert label in page
+    assert ".row11 {\n  background: var(--nctwin-paper-bg);\n  border-top:" in page
     assert html_table(wide, transpose=False).count("<tr>") == 4  # group row, header, two rows
-    assert "nctwin-start-row" not in html_table(wide.iloc[:, :12])  # 12 columns: as they are
+    assert "row_heading" not in html_table(wide.iloc[:, :12])  # 12 columns: as they are
 
 
 def test_words_may_break_after_underscores():

@@ -25,7 +25,7 @@ from nctwin.physics.surfaces import (
     iso_parametric_path,
     paper_surface,
 )
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 TOL_UM = 1e-6  # the accuracy the exact method promises
 

@@ -111,7 +111,7 @@ def test_time_by_block_length_splits_the_path(triangle_run):
 
 def test_models_are_table2():
     from nctwin.chapters.sun2022 import MODELS
-    from nctwin.report.tables import load_paper_table
+    from nctwin.report.papers import load_paper_table
 
     table2 = load_paper_table("sun2022_table2")
     paper = {

@@ -38,7 +38,8 @@ def test_conditions_read_table3_and_pocket1():
 
 
 def test_the_papers_own_numbers_pass_every_claim_it_makes():
-    from nctwin.report.tables import OPS, load_paper_table
+    from nctwin.report.claims import OPS
+    from nctwin.report.papers import load_paper_table
 
     t3 = load_paper_table("sun2022_table3").sort_values("pocket")
     t4 = load_paper_table("sun2022_table4").sort_values("pocket")

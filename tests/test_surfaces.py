@@ -14,7 +14,7 @@ from nctwin.physics.surfaces import (
     iso_parametric_path,
     paper_surface,
 )
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 PAPER = load_paper_table("zhang2023_surfaces").set_index("surface")
 

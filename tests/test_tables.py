@@ -1,4 +1,5 @@
-"""nctwin.report.tables: errors, joins, claims, atomic results files, and the paper CSVs."""
+"""nctwin.report.papers, results, display and nctwin.metrics: errors, joins, claims, atomic results
+files, and the paper CSVs."""
 
 from __future__ import annotations
 
@@ -11,19 +12,18 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nctwin.report import tables
-from nctwin.report.tables import (
-    Claim,
+from nctwin.metrics import accuracy_pct, error_pct
+from nctwin.report.claims import Claim
+from nctwin.report.display import format_paper_table, format_table
+from nctwin.report.papers import (
     UnknownTableError,
-    accuracy_pct,
-    error_pct,
-    format_paper_table,
-    format_table,
+    available_tables,
     load_paper_table,
+    paper_tables,
+    papers_dir,
     side_by_side,
-    write_claims,
-    write_table,
 )
+from nctwin.report.results import write_claims, write_table
 
 PAPERS = {
     "chien2023": "Chien, Sencer & Ward 2023",
@@ -32,7 +32,7 @@ PAPERS = {
     "denkena2020": "Denkena, Bergmann & Stoppel 2020",
     "zhang2023": "Zhang et al. 2023",
 }
-CSV_FILES = sorted(tables.papers_dir().glob("*.csv"))
+CSV_FILES = sorted(papers_dir().glob("*.csv"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -350,12 +350,12 @@ def test_format_paper_table_title_and_footnotes():
 
 
 def test_there_are_tables_for_every_paper():
-    names = tables.available_tables()
+    names = available_tables()
     for key in PAPERS:
-        assert tables.paper_tables(key), f"no table for {key}"
+        assert paper_tables(key), f"no table for {key}"
     assert set(names) == {p.stem for p in CSV_FILES}
-    assert tables.paper_tables("chien2023", selected=["sun2022"]) == []
-    assert tables.paper_tables("chien2023", selected=None)[0].startswith("chien2023_")
+    assert paper_tables("chien2023", selected=["sun2022"]) == []
+    assert paper_tables("chien2023", selected=None)[0].startswith("chien2023_")
 
 
 @pytest.mark.parametrize("path", CSV_FILES, ids=lambda p: p.stem)
@@ -399,7 +399,7 @@ def test_data_env_override(tmp_path, monkeypatch):
     (tmp_path / "papers").mkdir()
     (tmp_path / "papers" / "own_table1.csv").write_text("paper,table,v\nMe 2024,Table 1,3\n")
     monkeypatch.setenv("NCTWIN_DATA", str(tmp_path))
-    assert tables.available_tables() == ["own_table1"]
+    assert available_tables() == ["own_table1"]
     assert load_paper_table("own_table1")["v"].tolist() == [3]
 
 
@@ -470,7 +470,7 @@ def test_denkena_training_grid_size():
 
 
 def test_paper_tables_lists_numbered_tables_first():
-    names = tables.paper_tables("zhang2023")
+    names = paper_tables("zhang2023")
     numbered = [n for n in names if "_table" in n]
     assert names[: len(numbered)] == numbered
     assert [int(n.rsplit("table", 1)[1]) for n in numbered] == sorted(

@@ -26,7 +26,7 @@ from nctwin.programs.thinwall import (
     start_mm,
     thinwall_programs,
 )
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from nctwin.report import verdicts
-from nctwin.report.tables import Claim, write_claims
+from nctwin.report.claims import Claim
+from nctwin.report.results import write_claims
 
 
 def notebook(path: Path, cells: list[tuple[str, str]]) -> None:

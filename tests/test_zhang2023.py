@@ -15,7 +15,7 @@ from nctwin.chapters import zhang2023 as zh
 from nctwin.chapters import zhang2023_seeds as zs
 from nctwin.learn.models import BPConfig, build_bp
 from nctwin.learn.train import Scaler, TrainConfig, Trained
-from nctwin.report.tables import load_paper_table
+from nctwin.report.papers import load_paper_table
 
 
 def test_split_is_seeded_disjoint_and_sized() -> None:

@@ -30,7 +30,7 @@ from .estimate.blend_planner import blend_planner
 from .estimate.block_overlap import block_overlap
 from .estimate.kernel import kernel
 from .machine import Machine, Profile, profile_path, write_control
-from .report.tables import error_pct
+from .metrics import error_pct
 from .runner import run_tasks
 from .toolpath import MotionKind, Toolpath
 

@@ -61,10 +61,11 @@ from ..learn.seeds import fit_seeds
 from ..learn.train import TrainConfig, Trained
 from ..machine import Profile
 from ..methods import chien2023 as chien
+from ..metrics import error_pct
 from ..motion import Motion
 from ..physics.measure import Recording
 from ..programs import write_programs
-from ..report.tables import error_pct, side_by_side
+from ..report.papers import side_by_side
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath

@@ -17,7 +17,7 @@ import pandas as pd
 
 from ..machine import Profile
 from ..programs.training import contour_program
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 from .chien2023 import simulate_one
 
 __all__ = ["best_share", "zigzag_share_rows"]

@@ -16,9 +16,9 @@ import numpy as np
 import pandas as pd
 
 from ..programs.training import ProgramSpec
-from ..report.claims import bootstrap_interval, with_seeds
+from ..report.claims import Claim, bootstrap_interval, with_seeds
 from ..report.conditions import Condition
-from ..report.tables import Claim, load_paper_table
+from ..report.papers import load_paper_table
 
 __all__ = [
     "CAM_POINTS",

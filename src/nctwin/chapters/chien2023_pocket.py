@@ -33,7 +33,7 @@ from ..programs.band_pocket import (
     band_pocket_rings,
 )
 from ..programs.pocket import pocket_stats
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 from .chien2023 import simulate_one
 
 __all__ = ["MACHINE_B_RECORDING", "cam_errors", "pocket_targets", "solve_pocket"]

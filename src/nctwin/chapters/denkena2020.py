@@ -30,7 +30,7 @@ from ..learn.train import TrainConfig, Trained
 from ..methods import denkena2020 as fm
 from ..physics import drives
 from ..report.claims import claims_by_seed
-from ..report.tables import side_by_side
+from ..report.papers import side_by_side
 from .denkena2020_bench import (
     DIRECTIONS,
     TOOL,
@@ -538,7 +538,7 @@ def kind_means(table: pd.DataFrame, paper2: pd.DataFrame) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        :func:`~nctwin.report.tables.side_by_side` on ``process, axis`` of the mean
+        :func:`~nctwin.report.papers.side_by_side` on ``process, axis`` of the mean
         ``lstm_rmse_n``, ``model_rmse_n`` (over the cut) and ``max_abs_force_n``.
     """
     cut = table.drop(columns=["lstm_rmse_n", "model_rmse_n"]).rename(

@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..report.claims import bootstrap_interval, claims_by_seed, with_seeds
+from ..report.claims import Claim, bootstrap_interval, claims_by_seed, with_seeds
 from ..report.conditions import Condition
-from ..report.tables import Claim, load_paper_table
+from ..report.papers import load_paper_table
 from .denkena2020 import Recorded, Windows, _rmse, reversal_scores, summary, table2
 from .denkena2020_bench import Process
 

@@ -46,11 +46,13 @@ from ..kernel import accdec, fanuc
 from ..kernel.fanuc import FanucRun
 from ..machine import Machine, load_profile
 from ..methods.lee2022 import check_program
+from ..metrics import accuracy_pct, error_pct
 from ..paths import data_dir
 from ..programs.finishing3d import finishing3d_program, program_statistics, real_cam_text
 from ..programs.iso10791 import test_piece_program
 from ..recordings import RecordedProgram, public_program_text
-from ..report.tables import Claim, accuracy_pct, error_pct, load_paper_table
+from ..report.claims import Claim
+from ..report.papers import load_paper_table
 from ..toolpath import MotionKind, Toolpath
 from .lee2022_testbed import test_piece_params
 from .your_program import ProgramResult, block_feeds, block_summary, program_times, run_program

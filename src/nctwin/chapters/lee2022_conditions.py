@@ -12,7 +12,7 @@ from ..controls import AccDecControl, FanucControl
 from ..kernel.fanuc import FanucRun
 from ..machine import Machine
 from ..report.conditions import Condition
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 from .lee2022 import TEST_PIECE
 
 __all__ = ["INPOS_TOL_PCT", "RUN_TIME_TOL_PCT", "paper_conditions"]

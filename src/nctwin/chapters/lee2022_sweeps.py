@@ -28,6 +28,7 @@ from ..controls import AccDecControl, FanucControl
 from ..estimate.block_overlap import block_overlap
 from ..kernel import fanuc
 from ..machine import Machine
+from ..metrics import accuracy_pct, error_pct
 from ..paths import data_dir
 from ..programs.finishing3d import (
     FinishingParams,
@@ -35,7 +36,6 @@ from ..programs.finishing3d import (
     program_statistics,
     real_cam_text,
 )
-from ..report.tables import accuracy_pct, error_pct
 from ..toolpath import Toolpath
 
 __all__ = [

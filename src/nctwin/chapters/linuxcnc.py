@@ -49,9 +49,10 @@ from ..identify import identified_block_overlap
 from ..kernel import linuxcnc
 from ..learn.train import Trained
 from ..machine import Machine, Profile
+from ..metrics import error_pct
 from ..recordings import TRACE_PERIOD_S, RecordedProgram, public_program_text
+from ..report.claims import Claim
 from ..report.conditions import Condition
-from ..report.tables import Claim, error_pct
 from ..targets import block_targets
 from ..toolpath import MotionKind, PathMode, Toolpath
 from .your_program import ProgramResult, block_feeds, program_times, run_program

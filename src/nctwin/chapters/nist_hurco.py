@@ -54,9 +54,9 @@ from ..calibrate import (
 )
 from ..identify import identified_block_overlap
 from ..mtconnect import REASONS, nist_runs_table
-from ..report.claims import bootstrap_interval, with_seeds
+from ..report.claims import Claim, bootstrap_interval, with_seeds
 from ..report.conditions import Condition
-from ..report.tables import Claim, load_paper_table
+from ..report.papers import load_paper_table
 from ..runtimes import machine_runs, motion_window
 from . import nist_learned
 from .nist_learned import _nist_runs

@@ -33,10 +33,10 @@ from ..kernel import fir
 from ..learn.train import TrainConfig, Trained, fit
 from ..machine import Profile
 from ..methods import sun2022 as sun
+from ..metrics import error_pct
 from ..motion import Motion
 from ..physics.measure import ControllerSamples, controller_samples, nearest_sample
 from ..programs.thinwall import POCKETS, pocket_program, start_mm
-from ..report.tables import error_pct
 from ..runner import run_tasks
 from ..targets import block_targets
 from ..toolpath import MotionKind, Toolpath

@@ -17,9 +17,10 @@ import pandas as pd
 
 from ..learn.train import Trained
 from ..methods import sun2022 as sun
-from ..report.claims import bootstrap_interval, with_seeds
+from ..metrics import error_pct
+from ..report.claims import Claim, bootstrap_interval, with_seeds
 from ..report.conditions import Condition
-from ..report.tables import Claim, error_pct, load_paper_table
+from ..report.papers import load_paper_table
 from ..toolpath import MotionKind
 from .sun2022 import IMPROVED_POCKETS, PocketRun, predict_all_feeds
 

@@ -37,8 +37,9 @@ from ..estimate.cam import cam
 from ..gcode import parse
 from ..kernel import fir
 from ..machine import Profile, load_profile
+from ..metrics import error_pct
 from ..programs.thinwall import POCKETS, PocketSpec, pocket_program, start_mm
-from ..report.tables import error_pct, load_paper_table
+from ..report.papers import load_paper_table
 from .sun2022_claims import CAM_POINTS, CAM_TIME_TOL_PCT, CL_TOL_PCT
 
 __all__ = [

@@ -24,7 +24,8 @@ import numpy as np
 import pandas as pd
 
 from ..gcode import read_text
-from ..report.tables import error_pct, show
+from ..metrics import error_pct
+from ..report.display import show
 from ..toolpath import Toolpath
 
 __all__ = [

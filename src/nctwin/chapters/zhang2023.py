@@ -56,7 +56,7 @@ from ..checks import best_time_s
 from ..learn.models import BPConfig
 from ..learn.train import TrainConfig, Trained, fit, load_checkpoint
 from ..physics.steperror import step_error_iterative_um, step_error_samples, step_error_um
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 from .zhang2023_surfaces import (
     SurfaceData,
     chord_check,

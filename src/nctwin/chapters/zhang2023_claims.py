@@ -17,9 +17,8 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from ..report.claims import bootstrap_interval, claims_by_seed, with_seeds
+from ..report.claims import Claim, bootstrap_interval, claims_by_seed, with_seeds
 from ..report.conditions import Condition
-from ..report.tables import Claim
 from .zhang2023 import FINETUNE_EPOCHS
 from .zhang2023_seeds import Networks
 from .zhang2023_surfaces import SurfaceData

@@ -19,7 +19,7 @@ from ..physics.steperror import (
     step_error_um,
 )
 from ..physics.surfaces import Cylinder, Sphere, ToolPath, iso_parametric_path, paper_surface
-from ..report.tables import load_paper_table, side_by_side
+from ..report.papers import load_paper_table, side_by_side
 
 __all__ = ["SurfaceData", "chord_check", "paper_hidden", "surface_data", "surfaces_table"]
 
@@ -87,7 +87,7 @@ def surfaces_table(data: dict[int, SurfaceData], paper_surfaces: pd.DataFrame) -
         One row per surface: ``x_mm``, ``y_mm`` (extent of the CC points), ``z_max_mm``,
         ``segments``, ``err_min_um``, ``err_max_um``, ``below_0p01um_pct``, ``convex_pct``
         (rounded to 4 decimals), beside the paper's bounding box, sample count and step-error
-        range (:func:`~nctwin.report.tables.side_by_side`).
+        range (:func:`~nctwin.report.papers.side_by_side`).
     """
     ours = pd.DataFrame(
         [

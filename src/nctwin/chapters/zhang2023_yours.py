@@ -39,7 +39,7 @@ import pandas as pd
 from ..learn.train import Trained
 from ..physics.steperror import sample_columns, step_error_samples, step_error_um
 from ..physics.surfaces import GridSurface, iso_parametric_path
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 from .your_program import domain_notes, show_section
 from .zhang2023_seeds import ensemble_um
 

@@ -36,7 +36,7 @@ import numpy as np
 from scipy import optimize
 
 from ..checks import check_range
-from ..report.tables import load_paper_table
+from ..report.papers import load_paper_table
 
 __all__ = [
     "PAPER_BUMPS",

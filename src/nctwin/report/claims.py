@@ -1,4 +1,5 @@
-"""Report a chapter's claims: write ``results/<stem>/claims.json`` and print each claim.
+"""A paper's claims (:class:`Claim`, one checkable statement each) and their report: write
+``results/<stem>/claims.json`` and print each claim.
 
 Every chapter ends with one call,
 
@@ -6,34 +7,41 @@ Every chapter ends with one call,
 
     report_claims(STEM, chapter.claims(...));
 
-where ``chapter.claims`` builds the chapter's :class:`~nctwin.report.tables.Claim` list from its
-tables. A failing claim is reported (``FAILS``), never asserted away. In a notebook, the call
-also glues the chapter's status and why (``chapter_status``, ``chapter_status_why``: the
-Verdicts page's, :func:`nctwin.report.verdicts.status_of`), which the chapter's opening shows.
+where ``chapter.claims`` builds the chapter's :class:`Claim` list from its tables. A failing
+claim is reported (``FAILS``), never asserted away. In a notebook, the call also glues the
+chapter's status and why (``chapter_status``, ``chapter_status_why``: the Verdicts page's,
+:func:`nctwin.report.verdicts.status_of`), which the chapter's opening shows.
 
 The printed line is :data:`LINE` with :data:`VERDICTS` unless a chapter keeps its own (the
 chapters were written with slightly different lines, and their checked outputs stay as they
-are); ``table=True`` prints the claims as a table instead, one row per
-:meth:`~nctwin.report.tables.Claim.to_dict` record.
+are); ``table=True`` prints the claims as a table instead, one row per :meth:`Claim.to_dict`
+record.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
+import operator
 from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from .conditions import Condition
-from .tables import OPS, Claim, format_table, write_claims
+from .display import format_table
+from .results import write_claims
 from .verdicts import grouped, status_of
 
 __all__ = [
     "LINE",
     "NOT_TESTED",
+    "OPS",
     "VERDICTS",
+    "WHOSE",
     "Claim",
     "bootstrap_interval",
     "claims_by_seed",
@@ -42,6 +50,18 @@ __all__ = [
     "with_seeds",
 ]
 
+#: Whose a claim is (:attr:`Claim.whose`).
+WHOSE = ("paper", "ours")
+
+OPS: dict[str, Callable[[float, float], bool]] = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+}
+"""Comparison operators a :class:`Claim` may use."""
+
 #: The line printed per claim: ``str.format`` fields ``verdict``, ``id``, ``text``, ``value``,
 #: ``op`` and ``threshold``.
 LINE = "{verdict}  {id}: {value:.2f} {op} {threshold:g}"
@@ -49,6 +69,117 @@ LINE = "{verdict}  {id}: {value:.2f} {op} {threshold:g}"
 #: :data:`NOT_TESTED` and the unmet conditions' ids after the line.
 VERDICTS = ("holds", "FAILS")
 NOT_TESTED = "not tested"
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One checkable statement of a paper: ``value op threshold``.
+
+    Parameters
+    ----------
+    id
+        Short stable identifier, e.g. ``"bilstm_beats_cam"``.
+    text
+        The claim in words, citing the paper, e.g. ``"BiLSTM error < 2.5 % (Chien, Table 1)"``.
+    value
+        Our reproduced number (converted to float). NaN means "not reproduced": the claim fails.
+    op
+        One of ``"<"``, ``"<="``, ``">"``, ``">="``, ``"=="``.
+    threshold
+        The bound the value is compared with, in the same unit as ``value``.
+    whose
+        ``"paper"``: the paper's own claim at its own level; ``"ours"``: a check of the
+        project's own (a program beyond the paper's, an ablation), which cites no paper section.
+    requires
+        Ids of the conditions (:class:`~nctwin.report.conditions.Condition`) the claim is
+        tested under: where one is unmet, the claim is not tested.
+    unmet
+        Those of ``requires`` that are unmet (set by
+        :func:`report_claims` from the chapter's conditions).
+    seeds_passing, seeds
+        For a learned claim judged on an ensemble: how many of the ``seeds`` single networks
+        pass the claim on their own ("k of n"); None elsewhere.
+    interval
+        For a learned claim: a bootstrap interval of ``value`` over the seeds
+        (:func:`bootstrap_interval`), ``(low, high)``; None elsewhere.
+
+    Raises
+    ------
+    ValueError
+        If ``op`` is not one of :data:`OPS`, ``whose`` not one of :data:`WHOSE`, or
+        ``seeds_passing`` outside 0 to ``seeds``.
+    """
+
+    id: str
+    text: str
+    value: float
+    op: str
+    threshold: float
+    whose: str = "paper"
+    requires: tuple[str, ...] = ()
+    unmet: tuple[str, ...] = ()
+    seeds_passing: int | None = None
+    seeds: int | None = None
+    interval: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.op not in OPS:
+            raise ValueError(f"op must be one of {list(OPS)}, got {self.op!r}")
+        if self.whose not in WHOSE:
+            raise ValueError(f"whose = {self.whose!r} is out of range: allowed {', '.join(WHOSE)}")
+        if (self.seeds_passing is None) != (self.seeds is None) or (
+            self.seeds is not None and not 0 <= self.seeds_passing <= self.seeds
+        ):
+            raise ValueError(
+                f"claim {self.id!r}: seeds_passing = {self.seeds_passing!r} is out of range: "
+                f"allowed 0 to seeds ({self.seeds!r}), both set or neither"
+            )
+        if self.interval is not None:
+            object.__setattr__(self, "interval", tuple(float(v) for v in self.interval))
+        object.__setattr__(self, "value", float(self.value))
+        object.__setattr__(self, "threshold", float(self.threshold))
+        object.__setattr__(self, "requires", tuple(self.requires))
+        object.__setattr__(self, "unmet", tuple(self.unmet))
+
+    @property
+    def holds(self) -> bool:
+        """Whether ``value op threshold`` is true; False if either number is NaN."""
+        if math.isnan(self.value) or math.isnan(self.threshold):
+            return False
+        return bool(OPS[self.op](self.value, self.threshold))
+
+    @property
+    def status(self) -> str:
+        """``"not tested"`` where a condition it requires is unmet (it neither holds nor
+        fails), else ``"holds"`` or ``"fails"``."""
+        if self.unmet:
+            return "not tested"
+        return "holds" if self.holds else "fails"
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the JSON record ``{"id", "text", "value", "op", "threshold", "holds", "whose",
+        "status"}``, and ``"unmet"`` (the unmet conditions' ids) where there are any,
+        ``"seeds_passing"`` and ``"seeds"``, and ``"interval"`` (``[low, high]``) where set.
+
+        NaN numbers become ``None`` (JSON ``null``), since JSON has no NaN.
+        """
+        out = {
+            "id": self.id,
+            "text": self.text,
+            "value": None if math.isnan(self.value) else self.value,
+            "op": self.op,
+            "threshold": None if math.isnan(self.threshold) else self.threshold,
+            "holds": self.holds,
+            "whose": self.whose,
+            "status": self.status,
+        }
+        if self.unmet:
+            out["unmet"] = list(self.unmet)
+        if self.seeds is not None:
+            out |= {"seeds_passing": self.seeds_passing, "seeds": self.seeds}
+        if self.interval is not None:
+            out["interval"] = list(self.interval)
+        return out
 
 
 def format_claim(claim: Claim, line: str = LINE, verdicts: tuple[str, str] = VERDICTS) -> str:
@@ -102,7 +233,7 @@ def report_claims(
     line, verdicts : str, tuple of str
         How each claim is printed (:func:`format_claim`).
     table : bool
-        Print one table of the claims' records (:func:`~nctwin.report.tables.format_table`)
+        Print one table of the claims' records (:func:`~nctwin.report.display.format_table`)
         instead of one line per claim.
     conditions : iterable of Condition, optional
         The chapter's conditions (:func:`~nctwin.report.conditions.report_conditions`): each

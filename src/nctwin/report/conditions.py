@@ -5,7 +5,7 @@ A claim holds or fails only under the paper's conditions: the size of its parts,
 counts, feeds and tolerances, its sampling rate, its amount of data, CAM's error on its rows.
 Each chapter writes them to ``results/<stem>/conditions.csv`` before any method runs
 (:func:`report_conditions`), with the tolerance stated before looking, and names, in each claim,
-the conditions it is tested under (:attr:`Claim.requires <nctwin.report.tables.Claim.requires>`).
+the conditions it is tested under (:attr:`Claim.requires <nctwin.report.claims.Claim.requires>`).
 A claim whose conditions are unmet is *not tested*: it neither holds nor fails
 (:func:`nctwin.report.claims.report_claims`).
 
@@ -22,7 +22,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from .tables import show, write_table
+from .display import show
+from .results import write_table
 
 __all__ = ["CONDITION_COLUMNS", "Condition", "conditions_table", "report_conditions"]
 

@@ -1,16 +1,19 @@
-"""Tables as compact HTML for the book.
+"""Tables as compact HTML for the book, through pandas' :class:`~pandas.io.formats.style.Styler`.
 
-A chapter shows each result once (:func:`nctwin.report.tables.show`): the book renders the HTML
-written here, nbval compares the plain text of :func:`nctwin.report.tables.format_table`. The
-HTML fits a page column: short headers with the unit in parentheses (the full column name in the
-header's ``title``), floats rounded to a few significant digits, no index, and the paper's
-columns grouped under one "paper" header with the class ``nctwin-paper`` (styled by
-``book/_css/nctwin.css``). The same frame always gives the same HTML (no random ids), so nbval
-can compare it too.
+A chapter shows each result once (:func:`nctwin.report.display.show`): the book renders the HTML
+written here, nbval compares the plain text of :func:`nctwin.report.display.format_table` (and,
+in the cells it checks, this HTML too). The HTML fits a page column: short headers with the unit
+in parentheses (the full column name in the header's ``title``), floats rounded to a few
+significant digits, no index, numbers in cells of the class ``nctwin-num`` (right-aligned, never
+broken), and the paper's columns grouped under one "paper" header. The paper's cells are tinted
+by the table's own style rules, which take their colours from ``book/_css/nctwin.css``
+(``--nctwin-paper-bg``, ``--nctwin-paper-rule``). The table's id is derived from its content, so
+the same frame always gives the same HTML and a page's tables do not share style rules.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Sequence
 from html import escape
@@ -18,12 +21,21 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from pandas.io.formats.style import Styler
 
 __all__ = ["TRANSPOSE_MIN_COLUMNS", "format_value", "html_table", "short_header"]
 
 #: A table of at least this many columns and at most a third as many rows is shown transposed
 #: (one row per column), so that it fits the page column (``transpose=None``).
 TRANSPOSE_MIN_COLUMNS = 13
+
+#: Style of the paper's cells and of the rule before the first of them: colours from the book's
+#: stylesheet (``book/_css/nctwin.css``).
+_PAPER_CSS = "background: var(--nctwin-paper-bg)"
+_START_CSS = {
+    "columns": "border-left: var(--nctwin-paper-rule)",
+    "index": "border-top: var(--nctwin-paper-rule)",
+}
 
 #: Column-name suffixes and the header text they become, longest match first.
 _UNITS: tuple[tuple[str, str], ...] = (
@@ -92,7 +104,7 @@ def html_table(
     notes: Sequence[str] = (),
     transpose: bool | None = None,
 ) -> str:
-    """Render a table as compact HTML, ``<div class="nctwin-table"><table>...``.
+    """Render a table as compact HTML, ``<div class="nctwin-table"><style>...<table>...``.
 
     Parameters
     ----------
@@ -115,7 +127,7 @@ def html_table(
     Returns
     -------
     str
-        The HTML; the same frame always gives the same text.
+        The HTML; the same arguments always give the same text.
     """
     body = df.reset_index(drop=True)
     group = "paper"
@@ -124,72 +136,99 @@ def html_table(
         group = f"paper ({body[source].iloc[0]})"
         body = body.drop(columns=source)
     columns = [str(c) for c in body.columns]
-    paper = [bool(prefix) and c.startswith(prefix) for c in columns]
-    first = paper.index(True) if any(paper) else -1
-    numeric = [
-        pd.api.types.is_numeric_dtype(body[c]) and not pd.api.types.is_bool_dtype(body[c])
-        for c in body.columns
-    ]
-
-    def attr(j: int, *, cell: bool) -> str:
-        names = ["nctwin-paper"] * paper[j] + ["nctwin-start"] * (j == first)
-        names += ["nctwin-num"] * (cell and numeric[j])
-        return f' class="{" ".join(names)}"' if names else ""
-
     if transpose is None:
         transpose = len(columns) >= TRANSPOSE_MIN_COLUMNS and 3 * len(body) <= len(columns)
-    out = ['<div class="nctwin-table"><table>']
-    if caption:
-        out.append(f"<caption>{escape(caption)}</caption>")
+    key = repr((body.to_csv(), columns, digits, prefix, group, caption, list(notes), transpose))
+    uuid = hashlib.sha256(key.encode()).hexdigest()[:12]
     if transpose:
-        heads = "".join(f"<th>{_text(format_value(v, digits))}</th>" for v in body.iloc[:, 0])
-        first_head = escape(short_header(columns[0], prefix))
-        out.append(
-            f'<thead><tr><th title="{escape(columns[0])}">{first_head}</th>{heads}</tr></thead>'
-            "<tbody>"
-        )
-        for j in range(1, len(columns)):
-            names = ["nctwin-paper"] * paper[j] + ["nctwin-start-row"] * (j == first)
-            row_attr = f' class="{" ".join(names)}"' if names else ""
-            label = short_header(columns[j], prefix) + (" (paper)" if paper[j] else "")
-            td = '<td class="nctwin-num">' if numeric[j] else "<td>"
-            cells = "".join(f"{td}{_text(format_value(v, digits))}</td>" for v in body.iloc[:, j])
-            out.append(
-                f'<tr{row_attr}><th title="{escape(columns[j])}">{escape(label)}</th>{cells}</tr>'
-            )
-        out.append("</tbody></table>")
-        return _close(out, notes)
-    out.append("<thead>")
-    if any(paper):
-        ours = f'<th colspan="{first}"></th>' if first else ""
-        out.append(
-            f'<tr>{ours}<th colspan="{sum(paper)}" class="nctwin-paper nctwin-start">'
-            f"{escape(group)}</th></tr>"
-        )
-    headers = (
-        f'<th{attr(j, cell=False)} title="{escape(c)}">{escape(short_header(c, prefix))}</th>'
-        for j, c in enumerate(columns)
-    )
-    out.append(f"<tr>{''.join(headers)}</tr></thead><tbody>")
-    for row in body.itertuples(index=False, name=None):
-        cells = (
-            f"<td{attr(j, cell=True)}>{_text(format_value(v, digits))}</td>"
-            for j, v in enumerate(row)
-        )
-        out.append(f"<tr>{''.join(cells)}</tr>")
-    out.append("</tbody></table>")
-    return _close(out, notes)
-
-
-def _text(text: str) -> str:
-    """Escaped cell text that may break after ``_`` and ``/`` (long program names wrap)."""
-    return escape(text).replace("_", "_<wbr>").replace("/", "/<wbr>")
-
-
-def _close(out: list[str], notes: Sequence[str]) -> str:
-    """Append the footnotes and close the ``div``."""
+        styler = _transposed(body, columns, prefix, digits, uuid)
+    else:
+        styler = _upright(body, columns, prefix, group, digits, uuid)
+    if caption:
+        styler.set_caption(escape(caption))
+    out = ['<div class="nctwin-table">', styler.to_html().rstrip()]
     if notes:
         items = "".join(f"<li>{escape(n)}</li>" for n in notes)
         out.append(f'<ol class="nctwin-notes">{items}</ol>')
     out.append("</div>")
     return "\n".join(out)
+
+
+def _upright(
+    body: pd.DataFrame, columns: list[str], prefix: str, group: str, digits: int, uuid: str
+) -> Styler:
+    """One column per column: the paper's under a ``group`` header (when there are any)."""
+    paper = [_is_paper(c, prefix) for c in columns]
+    frame = body.set_axis(range(len(columns)), axis=1)
+    if any(paper):
+        labels = [(group if p else "", j) for j, p in enumerate(paper)]
+        frame.columns = pd.MultiIndex.from_tuples(labels)
+    styler = Styler(frame, uuid=uuid, cell_ids=False).hide(axis="index")
+    styler.format(lambda v: _text(format_value(v, digits)))
+    styler.format_index(
+        lambda j: _header(columns[j], prefix), axis="columns", level=frame.columns.nlevels - 1
+    )
+    if any(paper):
+        styler.format_index(escape="html", axis="columns", level=0)
+    numeric = [_num_class(body, j) for j in range(len(columns))]
+    styler.set_td_classes(pd.DataFrame([numeric] * len(frame), columns=frame.columns))
+    return _group(styler, list(frame.columns), paper, "columns")
+
+
+def _transposed(
+    body: pd.DataFrame, columns: list[str], prefix: str, digits: int, uuid: str
+) -> Styler:
+    """One row per column after the first, whose values head the columns; the paper's rows
+    labelled ``(paper)``."""
+    paper = [_is_paper(c, prefix) for c in columns]
+    frame = body.iloc[:, 1:].T.set_axis(range(1, len(columns)), axis=0)
+    frame = frame.set_axis(range(len(body)), axis=1)
+    frame.columns.name = _header(columns[0], prefix)
+    heads = [_text(format_value(v, digits)) for v in body.iloc[:, 0]]
+    styler = Styler(frame, uuid=uuid, cell_ids=False)
+    styler.format(lambda v: _text(format_value(v, digits)))
+    styler.format_index(heads.__getitem__, axis="columns")
+    styler.format_index(
+        lambda j: _header(columns[j], prefix, " (paper)" if paper[j] else ""), axis="index"
+    )
+    numeric = [[_num_class(body, j)] * len(body) for j in range(1, len(columns))]
+    styler.set_td_classes(pd.DataFrame(numeric, index=frame.index, columns=frame.columns))
+    return _group(styler, list(frame.index), paper[1:], "index")
+
+
+def _group(styler: Styler, labels: list[Any], paper: list[bool], axis: str) -> Styler:
+    """Tint the paper's columns (or rows, ``axis="index"``) and rule off the first of them."""
+    first = paper.index(True) if any(paper) else -1
+    styles = {}
+    for k, (label, is_paper) in enumerate(zip(labels, paper, strict=True)):
+        if is_paper:
+            props = _PAPER_CSS + (f"; {_START_CSS[axis]}" if k == first else "")
+            styles[label] = [{"selector": "", "props": props}]
+    if styles:
+        styler.set_table_styles(styles, axis=0 if axis == "columns" else 1)
+    return styler
+
+
+def _is_paper(column: str, prefix: str) -> bool:
+    """Whether a column is the paper's (its name starts with ``prefix``)."""
+    return bool(prefix) and column.startswith(prefix)
+
+
+def _num_class(body: pd.DataFrame, j: int) -> str:
+    """``"nctwin-num"`` (right-aligned, never broken) for a column ``j`` of numbers, else ``""``;
+    booleans are not numbers."""
+    values = body.iloc[:, j]
+    numeric = pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values)
+    return "nctwin-num" if numeric else ""
+
+
+def _header(column: str, prefix: str, suffix: str = "") -> str:
+    """A header cell's content: the short header (:func:`short_header`) and ``suffix``, with the
+    full column name as its ``title``."""
+    text = escape(short_header(column, prefix) + suffix)
+    return f'<span title="{escape(column)}">{text}</span>'
+
+
+def _text(text: str) -> str:
+    """Escaped cell text that may break after ``_`` and ``/`` (long program names wrap)."""
+    return escape(text).replace("_", "_<wbr>").replace("/", "/<wbr>")

@@ -208,7 +208,7 @@ def grouped(ids: list[str]) -> str:
 
 def status_of(records: list[dict]) -> tuple[str, str]:
     """A chapter's status (one of :data:`STATUSES`) and one sentence of why, from its claims'
-    records (:meth:`~nctwin.report.tables.Claim.to_dict`).
+    records (:meth:`~nctwin.report.claims.Claim.to_dict`).
 
     Of the paper's claims (``whose`` ``"paper"``): *reproduced* where every one is tested and
     holds; *not tested under the paper's conditions* where none is tested (their conditions
