@@ -58,7 +58,11 @@ def test_ini_holds_the_profile_limits():
     assert ini["TRAJ", "NO_FORCE_HOMING"] == "1"
     assert ini["KINS", "KINEMATICS"] == "trivkins coordinates=XYZ"
     assert int(ini["EMCMOT", "SERVO_PERIOD"]) == 1_000_000
-    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"].endswith("G64 P0.0254 Q0")
+    # linuxcnc_sim's tolerance is inf: LinuxCNC runs the startup mode as a plain G64 anyway
+    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"] == "G21 G90 G64"
+    finite = dataclasses.replace(PLANNER, blend_tol_mm=0.0254)
+    ini = _ini_values(lc.ini_text(MACHINE, finite))
+    assert ini["RS274NGC", "RS274NGC_STARTUP_CODE"] == "G21 G90 G64 P0.0254 Q0"
     assert not any(key.startswith("ARC_BLEND") for _, key in ini)
 
 
@@ -306,4 +310,10 @@ def test_experiment_conditions_by_hand():
     assert not conds["recordings_public"].met and not conds["recordings_broad"].met
     assert conds["trace_period"].ours == pytest.approx(10.0) and conds["trace_period"].met
     assert conds["feed_within_ini"].ours == 150.0 and conds["feed_within_ini"].met
+    # the profile gives the startup mode LinuxCNC's plain G64: met; a finite tolerance is not
+    assert conds["startup_mode_programs"].ours == 0.0 and conds["startup_mode_programs"].met
+    finite = dataclasses.replace(
+        profile, planner=dataclasses.replace(profile.planner, blend_tol_mm=0.0254)
+    )
+    conds = {c.id: c for c in rk.experiment_conditions(recordings, programs, finite)}
     assert conds["startup_mode_programs"].ours == 1.0 and not conds["startup_mode_programs"].met

@@ -20,7 +20,7 @@ from nctwin.targets import BlockTargets
 
 PROFILE = load_profile("linuxcnc_sim")
 MACHINE = PROFILE.machine  # X/Y 200 mm/s 1000 mm/s^2, Z 100 mm/s 500 mm/s^2
-PLANNER = PROFILE.control("planner")  # 1 ms, G64 P0.0254 where a program sets none
+PLANNER = PROFILE.control("planner")  # 1 ms, a plain G64 where a program sets none
 
 
 def col(name: str) -> int:
@@ -68,7 +68,7 @@ def test_path_acceleration_along_the_move():
 @pytest.mark.parametrize(
     ("g64", "tol", "naive"),
     [
-        ("", 0.0254, 0.0),  # LinuxCNC's start-up G64 P0.0254 Q0
+        ("", learned.TOL_CAP_MM, 0.0),  # LinuxCNC runs the start-up mode as a plain G64
         ("G64 P0.1", 0.1, 0.1),  # P without Q: Q = P
         ("G64 P0.1 Q0", 0.1, 0.0),
         ("G64 P0.1 Q0.01", 0.1, 0.01),
@@ -148,7 +148,7 @@ def test_planner_ablation_on_recordings_by_hand():
 @pytest.mark.parametrize(
     ("program", "mode"),
     [
-        ("G1 X1 F600\n", "G64 P Q0"),  # the profile's tolerance, Q0
+        ("G1 X1 F600\n", "G64"),  # the startup mode: LinuxCNC runs a plain G64
         ("G64 P0.1\nG1 X1 F600\n", "G64 P Q>0"),  # Q = P
         ("G64 P0.1 Q0\nG1 X1 F600\nG64\nG1 X2\nG61\nG1 X3\nG61.1\nG1 X4\n",
          "G64 P Q0, G64, G61, G61.1"),

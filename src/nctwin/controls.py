@@ -46,7 +46,7 @@ def _check_period(period_s: float) -> None:
 
 
 def _check_tolerance(blend_tol_mm: float) -> None:
-    check_range("blend_tol_mm", blend_tol_mm, 0.0, 10.0)
+    check_range("blend_tol_mm", blend_tol_mm, 0.0, 10.0, allow_inf=True)
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,7 @@ class FirControl:
         Interpolation period, in (0, 0.1] s.
     blend_tol_mm : float
         Corner-blending tolerance where the program sets none (``G64 P`` overrides it), in
-        [0, 10] mm.
+        [0, 10] mm, or ``inf`` (no tolerance, a plain ``G64``).
     t1_s, t2_s : float
         Time constants of the two moving averages: acceleration ``F / T1``, jerk
         ``F / (T1 T2)``; in [0, 10] s (the longer must be at least one period).
@@ -346,8 +346,9 @@ class PlannerControl:
     period_s : float
         Trajectory (servo) period, in (0, 0.1] s: LinuxCNC's ``[TRAJ] CYCLE_TIME``.
     blend_tol_mm : float
-        Blending tolerance where the program sets no ``G64 P`` (LinuxCNC's startup code), in
-        [0, 10] mm.
+        Blending tolerance where the program sets no ``G61``/``G64`` (LinuxCNC's startup
+        code), in [0, 10] mm, or ``inf`` (no tolerance: a plain ``G64``, what LinuxCNC 2.9
+        runs there whatever its startup code asks; see ``data/machines/linuxcnc_sim.toml``).
     word_stops : bool
         True: the tool stops before the M-codes LinuxCNC's task waits for the motion to end
         for (:mod:`nctwin.estimate.task_waits`), as on LinuxCNC; False (default, a control

@@ -24,6 +24,7 @@ How the learned methods see a program is :mod:`nctwin.estimate.learned`'s.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -398,9 +399,10 @@ def experiment_conditions(
     * ``feed_within_ini``: the recorded path speed never above the INI's maximum velocity (the
       profile's ``max_feed_mm_s``) by more than 0.1 %;
     * ``startup_mode_programs``: no scored program runs a motion under the startup code's path
-      mode (a block before any ``G61``/``G64`` word): LinuxCNC was found to run such blocks as a
-      plain ``G64`` although the INI's ``RS274NGC_STARTUP_CODE`` sets a tolerance, which the
-      methods are given (:meth:`~nctwin.toolpath.Toolpath.effective_tolerance_mm`).
+      mode (a block before any ``G61``/``G64`` word) with the methods given another tolerance
+      than the plain ``G64`` LinuxCNC runs there, whatever its ``RS274NGC_STARTUP_CODE`` asks
+      (the profile's ``[control.planner]`` ``blend_tol_mm``, which
+      :meth:`~nctwin.toolpath.Toolpath.effective_tolerance_mm` gives such blocks).
 
     Parameters
     ----------
@@ -420,7 +422,8 @@ def experiment_conditions(
     trace = [(r.n_samples - 1) * period_s / (len(r.feed_mm_s) - 1) for r in recordings.values()]
     worst = max(trace, key=lambda t: abs(t - TRACE_PERIOD_S))
     feed = max(float(r.feed_mm_s.max()) for r in recordings.values())
-    moving = [(tp.path_mode[tp.kind != MotionKind.DWELL] == PathMode.DEFAULT).any()
+    plain = math.isinf(profile.control("planner").blend_tol_mm)
+    moving = [not plain and (tp.path_mode[tp.kind != MotionKind.DWELL] == PathMode.DEFAULT).any()
               for _, tp, _ in programs.values()]  # fmt: skip
     out = [
         Condition(
@@ -440,9 +443,9 @@ def experiment_conditions(
                   1000 * TRACE_PERIOD_S, 1000 * worst, "ms", tol_pct=1.0),
         Condition("feed_within_ini", "largest recorded path speed, at most the INI's maximum "
                   "velocity (+0.1 %)", max_feed, feed, "mm/s", high=1.001 * max_feed),
-        Condition("startup_mode_programs", "scored programs with motion under the startup "
-                  "code's path mode (LinuxCNC runs it as a plain G64)", 0.0, float(sum(moving)),
-                  "programs", high=0.0),
+        Condition("startup_mode_programs", "scored programs moving under the startup code's "
+                  "path mode with a tolerance other than the plain G64 LinuxCNC runs there",
+                  0.0, float(sum(moving)), "programs", high=0.0),
     ]  # fmt: skip
 
 

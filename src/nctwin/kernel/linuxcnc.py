@@ -13,11 +13,12 @@ How a run works
   ``[AXIS_*]``/``[JOINT_*]`` limits from the axis limits, ``[TRAJ]`` ``MAX_LINEAR_VELOCITY`` =
   ``max_feed_mm_s``, ``MAX_LINEAR_ACCELERATION`` = the largest axis acceleration, no
   ``ARC_BLEND_*`` settings (LinuxCNC's defaults), no homing, start at X0 Y0 Z0, and the startup
-  code ``G21 G90 G64 P<blend_tol_mm> Q0`` (the control's), so a program that sets no
-  ``G61``/``G64`` blends within that tolerance without merging segments (LinuxCNC's own
-  default is ``G64 P0.0254 Q0``; a ``G64 P`` without Q sets Q = P, which turns on its
-  naive-CAM detector). A plain ``G64`` (no
-  P) means P0 on LinuxCNC: no tolerance.
+  code ``G21 G90 G64 P<blend_tol_mm> Q0`` (the control's; ``G21 G90 G64`` where it is ``inf``).
+  A plain ``G64`` (no P) means P0 on LinuxCNC: no tolerance; a ``G64 P`` without Q sets Q = P,
+  which turns on its naive-CAM detector. LinuxCNC 2.9 runs the moves before a program's first
+  ``G61``/``G64`` as a plain ``G64`` whatever the startup code asks (measured on LinuxCNC's
+  ``bracket`` example, see ``data/machines/linuxcnc_sim.toml``), so ``linuxcnc_sim``'s
+  tolerance is ``inf``.
 * Each run gets its own folder and private namespaces (``unshare``: PID, mount, IPC, network):
   the folder is the instance's ``/tmp`` and ``HOME``, ``/dev/shm`` is a fresh tmpfs. Instances
   never see each other's lock file, shared memory or NML port, and nothing is left behind; when
@@ -52,6 +53,7 @@ from __future__ import annotations
 
 import glob
 import json
+import math
 import os
 import pwd
 import re
@@ -183,7 +185,7 @@ def ini_text(machine: Machine, control: PlannerControl) -> str:
         f"CYCLE_TIME = {control.period_s!r}",
         "[RS274NGC]",
         f"PARAMETER_FILE = {d}/sim.var",
-        f"RS274NGC_STARTUP_CODE = G21 G90 G64 P{control.blend_tol_mm!r} Q0",
+        f"RS274NGC_STARTUP_CODE = G21 G90 {_startup_mode(control.blend_tol_mm)}",
         "[EMCMOT]",
         "EMCMOT = motmod",
         "COMM_TIMEOUT = 1.0",
@@ -217,6 +219,12 @@ def ini_text(machine: Machine, control: PlannerControl) -> str:
         lines += [f"[JOINT_{i}]", "TYPE = LINEAR", "HOME = 0.0", *limits]
         lines += [f"FERROR = {TRAVEL_MM!r}", f"MIN_FERROR = {TRAVEL_MM!r}", "HOME_SEQUENCE = 0"]
     return "\n".join(lines) + "\n"
+
+
+def _startup_mode(blend_tol_mm: float) -> str:
+    """The startup code's path-control words: ``G64 P<tol> Q0``, or a plain ``G64`` for an
+    infinite tolerance."""
+    return "G64" if math.isinf(blend_tol_mm) else f"G64 P{blend_tol_mm!r} Q0"
 
 
 def hal_text() -> str:
