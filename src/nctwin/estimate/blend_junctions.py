@@ -9,7 +9,7 @@ stated here as facts:
 
 1. **Kink speed** (``tpSetupTangent``, ``tcSetKinkProperties``): the rejected kink keeps the
    speed :math:`v_k = v_{\max}\, r_k / k` and an acceleration reduction :math:`r_k` on both
-   moves, with :math:`r_k` = :data:`~nctwin.estimate.blend_planner.KINK_RATIO` and :math:`k`
+   moves, with :math:`r_k` = :data:`KINK_RATIO` and :math:`k`
    the kink's acceleration share (doubled next to an arc, ``acc_scale_max /=
    BLEND_ACC_RATIO_TANGENTIAL``): at a 1° kink after an arc at 66 mm/s, about 3 mm/s.
 2. **Blend geometry** (``blendInit3FromArcLine``, ``blendInit3FromLineArc``,
@@ -23,7 +23,7 @@ stated here as facts:
    :math:`\theta = \pi/12`, and every blend fails where the other move is not in the arc's
    plane (``pmUnitCartsColinear`` of the binormal and the arc's normal).
 3. **Blend size and speed** (``blendParamKinematics``, ``blendComputeParameters``): as between
-   two lines (:func:`~nctwin.estimate.blend_planner.junction_blends`), with the lengths of 2,
+   two lines (:func:`~nctwin.estimate.blend_limits.junction_blends`), with the lengths of 2,
    the goal speed :math:`\max(v_1, v_2)` within the plane's velocity limit, and
    :math:`R` the planned radius and :math:`v_p` the planned speed.
 4. **The blend arc as it is made** (``blendArcLinePostProcess``, ``blendLineArcPostProcess``,
