@@ -9,7 +9,7 @@ stated here as facts:
 
 1. **Kink speed** (``tpSetupTangent``, ``tcSetKinkProperties``): the rejected kink keeps the
    speed :math:`v_k = v_{\max}\, r_k / k` and an acceleration reduction :math:`r_k` on both
-   moves, with :math:`r_k` = :data:`~nctwin.estimate.blend_planner.KINK_RATIO` and :math:`k`
+   moves, with :math:`r_k` = :data:`KINK_RATIO` and :math:`k`
    the kink's acceleration share (doubled next to an arc, ``acc_scale_max /=
    BLEND_ACC_RATIO_TANGENTIAL``): at a 1° kink after an arc at 66 mm/s, about 3 mm/s.
 2. **Blend geometry** (``blendInit3FromArcLine``, ``blendInit3FromLineArc``,
@@ -23,7 +23,7 @@ stated here as facts:
    :math:`\theta = \pi/12`, and every blend fails where the other move is not in the arc's
    plane (``pmUnitCartsColinear`` of the binormal and the arc's normal).
 3. **Blend size and speed** (``blendParamKinematics``, ``blendComputeParameters``): as between
-   two lines (:func:`~nctwin.estimate.blend_planner.junction_blends`), with the lengths of 2,
+   two lines (:func:`~nctwin.estimate.blend_limits.junction_blends`), with the lengths of 2,
    the goal speed :math:`\max(v_1, v_2)` within the plane's velocity limit, and
    :math:`R` the planned radius and :math:`v_p` the planned speed.
 4. **The blend arc as it is made** (``blendArcLinePostProcess``, ``blendLineArcPostProcess``,
@@ -46,15 +46,11 @@ stated here as facts:
    fails, the better of the other two is taken. A tangent pass runs both moves at
    :math:`1 - r_k` of their acceleration; a parabolic blend at half
    (``tcGetOverallMaxAccel``).
-
-Measured on LinuxCNC (``linuxcnc_sim``): a G17 quarter circle of 5 mm radius at 200 mm/s, a
-0.126 mm line turning 1° into it and a 10 mm line turning 2° more: 0.663 s, with its lowest
-speed 3.98 mm/s on a blend arc of 0.004 mm (rule 5: 0.004 mm / 1 ms); the model before these
-rules 0.544 s.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -189,6 +185,7 @@ def blend_plane_acc(u1: np.ndarray, u2: np.ndarray, axis_acc_mm_s2: np.ndarray) 
 
 
 def arc_junction_blends(
+    *,
     point: np.ndarray,
     u1: np.ndarray,
     u2: np.ndarray,
@@ -246,81 +243,19 @@ def arc_junction_blends(
     theta_t = np.arccos(-cos_turn) / 2.0
     made = (np.pi / 2.0 - theta_t >= 1e-6) & (theta_t >= 1e-6)
     b = _unit(np.cross(u1, u2))
-    normal = _unit(u2 - u1)
     made &= (~arc1 | _colinear(b, normal1)) & (~arc2 | _colinear(b, normal2))
-    r1 = np.linalg.norm(point - centre1, axis=1)
-    r2 = np.linalg.norm(point - centre2, axis=1)
-    convex1 = arc1 & (_dot(point - centre1, u2) < 0)
-    convex2 = arc2 & ~(_dot(point - centre2, u1) < 0)
-    phi1_max = np.minimum(sweep1 * 2.0 / 3.0, np.where(convex1, theta_t, np.pi / 2.0))
-    phi2_max = np.minimum(sweep2 / 3.0, np.where(convex2, theta_t, np.pi / 2.0))
-    theta = np.where(convex1, theta_t - phi1_max / 4.0, theta_t)
-    theta = np.minimum(theta, np.where(convex2, theta_t - phi2_max / 4.0, theta_t))
+    s1 = _Side.before(point, u2, arc1, centre1, sweep1, length1, theta_t)
+    s2 = _Side.after(point, u1, arc2, centre2, sweep2, length2, theta_t)
+    theta = np.where(s1.convex, theta_t - s1.phi_max_rad / 4.0, theta_t)
+    theta = np.minimum(theta, np.where(s2.convex, theta_t - s2.phi_max_rad / 4.0, theta_t))
     made &= ~(arc1 & arc2) | (theta >= _ARC_ARC_THETA_MIN)
-    with np.errstate(invalid="ignore"):
-        l1 = np.where(convex1, np.sin(phi1_max / 4.0) * r1, phi1_max * r1)
-        l2 = np.where(convex2, np.sin(phi2_max / 4.0) * r2, phi2_max * r2)
-    l1 = np.where(arc1, l1, length1 / 2.0)
-    l2 = np.where(arc2, l2, length2 / 2.0)
-    # blendComputeParameters, as between two lines
-    sin_t, tan_t = np.sin(theta), np.tan(theta)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        d_tol = np.cos(theta) * tol_mm / (1.0 - sin_t)
-        d_geom = np.minimum(np.minimum(l1, l2), d_tol)
-        r_geom = tan_t * d_geom
-        a_n = np.sqrt(0.75) * plane_acc
-        v_goal = np.minimum(np.maximum(speed1, speed2), plane_vel)
-        v_plan = np.minimum(np.sqrt(a_n * r_geom), v_goal)
-        a_para = 0.5 * plane_acc
-        t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
-        r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_geom)
-        radius = np.maximum(v_plan**2 / a_n, r_blend)
+    v_plan, radius = _blend_size(theta, s1, s2, speed1, speed2, tol_mm, plane_acc, plane_vel)
     made &= (radius >= 1e-12) & (radius * (np.pi - 2.0 * theta) >= _MIN_ARC_LENGTH)
-    # the circle as made: tangent to the line(s) and circle(s), then the exact trims
-    d1 = np.where(convex1, -radius, radius) + r1
-    d2 = np.where(convex2, -radius, radius) + r2
-    centre = np.full_like(point, np.nan)
-    trim1, trim2 = np.full(len(point), np.nan), np.full(len(point), np.nan)
-    both = arc1 & arc2
-    if both.any():
-        centre[both] = _circle_circle_centre(
-            point[both], centre1[both], centre2[both], d1[both], d2[both], b[both], normal[both]
-        )
-    first = arc1 & ~arc2
-    if first.any():
-        centre[first], trim2[first] = _line_circle_centre(
-            point[first], u2[first], b[first], centre1[first], d1[first], radius[first], 1.0
-        )
-    second = arc2 & ~arc1
-    if second.any():
-        centre[second], trim1[second] = _line_circle_centre(
-            point[second],
-            u1[second],
-            b[second],
-            centre2[second],
-            d2[second],
-            radius[second],
-            -1.0,
-        )
-    ang1 = _angle(point, centre, centre1)
-    ang2 = _angle(point, centre, centre2)
+    centre, trim1, trim2 = _blend_centre(point, u1, u2, b, s1, s2, radius)
+    fits, trim1, trim2, beta = _blend_contacts(point, u1, u2, centre, s1, s2, trim1, trim2)
     with np.errstate(invalid="ignore"):
         made &= np.linalg.norm(centre - point, axis=1) - radius <= tol_mm  # T_final
-        made &= ~arc1 | (ang1 <= phi1_max)
-        made &= ~arc2 | (ang2 <= phi2_max)
-        trim1 = np.where(arc1, ang1 * r1, trim1)
-        trim2 = np.where(arc2, ang2 * r2, trim2)
-        made &= (np.where(arc1, sweep1 - ang1, length1 - trim1) > 0) & (
-            np.where(arc2, sweep2 - ang2, length2 - trim2) > 0
-        )
-        # the arc between its two points of contact
-        start = np.where(arc1[:, None], centre1 + _unit(centre - centre1) * r1[:, None],
-                         point - u1 * trim1[:, None])  # fmt: skip
-        end = np.where(arc2[:, None], centre2 + _unit(centre - centre2) * r2[:, None],
-                       point + u2 * trim2[:, None])  # fmt: skip
-        beta = _angle(start, end, centre)
-        made &= beta >= 1e-6
-    made &= np.isfinite(trim1) & np.isfinite(trim2) & np.isfinite(beta)
+    made &= fits
     length = np.where(made, radius * beta, 0.0)
     return {
         "made": made,
@@ -330,6 +265,114 @@ def arc_junction_blends(
         "trim1": np.where(made, trim1, 0.0),
         "trim2": np.where(made, trim2, 0.0),
     }
+
+
+@dataclasses.dataclass(frozen=True)
+class _Side:
+    """One move at K junctions, the one before or the one after, as a blend sees it, shapes
+    (K,) (``centre_mm`` (K, 3)): whether it is an arc, its centre in the junction's plane and
+    radius, whether it is convex there, the most of its sweep the blend may take, its sweep as
+    LinuxCNC holds it, its programmed length and the length it offers the blend."""
+
+    arc: np.ndarray
+    centre_mm: np.ndarray
+    radius_mm: np.ndarray
+    convex: np.ndarray
+    phi_max_rad: np.ndarray
+    sweep_rad: np.ndarray
+    length_mm: np.ndarray
+    offered_mm: np.ndarray
+
+    @classmethod
+    def _of(cls, arc, point, centre, sweep, length, theta_t, convex, most) -> _Side:
+        r = np.linalg.norm(point - centre, axis=1)
+        phi_max = np.minimum(most, np.where(convex, theta_t, np.pi / 2.0))
+        with np.errstate(invalid="ignore"):
+            offered = np.where(convex, np.sin(phi_max / 4.0) * r, phi_max * r)
+        offered = np.where(arc, offered, length / 2.0)
+        return cls(arc, centre, r, convex, phi_max, sweep, length, offered)
+
+    @classmethod
+    def before(cls, point, u_next, arc, centre, sweep, length, theta_t) -> _Side:
+        """The move before: convex where the next move turns towards its centre; the blend
+        may take two thirds of its sweep."""
+        convex = arc & (_dot(point - centre, u_next) < 0)
+        return cls._of(arc, point, centre, sweep, length, theta_t, convex, sweep * 2.0 / 3.0)
+
+    @classmethod
+    def after(cls, point, u_before, arc, centre, sweep, length, theta_t) -> _Side:
+        """The move after: convex where the move before turns towards its centre; the blend
+        may take a third of its sweep."""
+        convex = arc & ~(_dot(point - centre, u_before) < 0)
+        return cls._of(arc, point, centre, sweep, length, theta_t, convex, sweep / 3.0)
+
+
+def _blend_size(theta, s1, s2, speed1, speed2, tol_mm, plane_acc, plane_vel):
+    """``blendComputeParameters`` as between two lines: the planned speed and radius, (K,)."""
+    sin_t, tan_t = np.sin(theta), np.tan(theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d_tol = np.cos(theta) * tol_mm / (1.0 - sin_t)
+        d_geom = np.minimum(np.minimum(s1.offered_mm, s2.offered_mm), d_tol)
+        r_geom = tan_t * d_geom
+        a_n = np.sqrt(0.75) * plane_acc
+        v_goal = np.minimum(np.maximum(speed1, speed2), plane_vel)
+        v_plan = np.minimum(np.sqrt(a_n * r_geom), v_goal)
+        a_para = 0.5 * plane_acc
+        t_blend = np.minimum(np.sqrt(2.0 * a_para * d_geom), v_plan) / a_para
+        r_blend = np.minimum(t_blend * v_plan / (np.pi - 2.0 * theta), r_geom)
+        radius = np.maximum(v_plan**2 / a_n, r_blend)
+    return v_plan, radius
+
+
+def _blend_centre(point, u1, u2, b, s1, s2, radius):
+    """The blend circle as made (``blend*PostProcess``): tangent to the line(s) and to the
+    arc(s)' circle(s); its centre (K, 3) and a line's trim (K,) (NaN where none or an arc)."""
+    d1 = np.where(s1.convex, -radius, radius) + s1.radius_mm
+    d2 = np.where(s2.convex, -radius, radius) + s2.radius_mm
+    centre = np.full_like(point, np.nan)
+    trim1, trim2 = np.full(len(point), np.nan), np.full(len(point), np.nan)
+    c1, c2 = s1.centre_mm, s2.centre_mm
+    normal = _unit(u2 - u1)
+    both = s1.arc & s2.arc
+    if both.any():
+        centre[both] = _circle_circle_centre(
+            point[both], c1[both], c2[both], d1[both], d2[both], b[both], normal[both]
+        )
+    first = s1.arc & ~s2.arc
+    if first.any():
+        centre[first], trim2[first] = _line_circle_centre(
+            point[first], u2[first], b[first], c1[first], d1[first], radius[first], 1.0
+        )
+    second = s2.arc & ~s1.arc
+    if second.any():
+        centre[second], trim1[second] = _line_circle_centre(
+            point[second], u1[second], b[second], c2[second], d2[second], radius[second], -1.0
+        )
+    return centre, trim1, trim2
+
+
+def _blend_contacts(point, u1, u2, centre, s1, s2, trim1, trim2):
+    r"""Where the blend circle touches the moves: whether it takes no more than it may of each
+    (bool), the exact trims, and the blend's turn :math:`\beta` between its two points of
+    contact, shapes (K,)."""
+    c1, c2, r1, r2 = s1.centre_mm, s2.centre_mm, s1.radius_mm, s2.radius_mm
+    ang1 = _angle(point, centre, c1)
+    ang2 = _angle(point, centre, c2)
+    with np.errstate(invalid="ignore"):
+        fits = (~s1.arc | (ang1 <= s1.phi_max_rad)) & (~s2.arc | (ang2 <= s2.phi_max_rad))
+        trim1 = np.where(s1.arc, ang1 * r1, trim1)
+        trim2 = np.where(s2.arc, ang2 * r2, trim2)
+        fits &= (np.where(s1.arc, s1.sweep_rad - ang1, s1.length_mm - trim1) > 0) & (
+            np.where(s2.arc, s2.sweep_rad - ang2, s2.length_mm - trim2) > 0
+        )
+        start = np.where(s1.arc[:, None], c1 + _unit(centre - c1) * r1[:, None],
+                         point - u1 * trim1[:, None])  # fmt: skip
+        end = np.where(s2.arc[:, None], c2 + _unit(centre - c2) * r2[:, None],
+                       point + u2 * trim2[:, None])  # fmt: skip
+        beta = _angle(start, end, centre)
+        fits &= beta >= 1e-6
+    fits &= np.isfinite(trim1) & np.isfinite(trim2) & np.isfinite(beta)
+    return fits, trim1, trim2, beta
 
 
 def parabolic_directions(
@@ -436,6 +479,7 @@ def choose_blends(
 def arc_junctions(
     moves: Toolpath,
     candidates: np.ndarray,
+    *,
     speed_mm_s: np.ndarray,
     req_speed_mm_s: np.ndarray,
     path_acc_mm_s2: np.ndarray,
@@ -496,6 +540,37 @@ def arc_junctions(
     if not len(j):
         return out
     arc = moves.is_arc
+    blend = _candidate_blends(moves, j, speed_mm_s, tol_mm, axis_acc_mm_s2, axis_vel_mm_s)
+    # a line's remainder passed in under GAP_CYCLES periods at the planned speed joins the
+    # blend arc before the choice (blendCheckConsume, arcFromBlendPoints3's line_length)
+    length = moves.lengths_mm
+    rest1 = length[j] - start_trim_mm[j] - blend["trim1"]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        consumed = ~arc[j] & blend["made"] & (rest1 < GAP_CYCLES * period_s * blend["v_plan"])
+    blend_len = blend["length"] + np.where(consumed, rest1, 0.0)
+    arc_speed = np.minimum(blend["v_plan"], blend_len / period_s)
+    kink_speed = np.minimum(speed_mm_s[j], speed_mm_s[j + 1]) * KINK_RATIO / kink_share[j]
+    parabolic = _parabolic_measure(moves, j, speed_mm_s, req_speed_mm_s, path_acc_mm_s2,
+                                   tol_mm, arc_rules)  # fmt: skip
+    out["choice"][j] = choose_blends(np.where(blend["made"], arc_speed, 0.0), kink_speed, parabolic)
+    out["kink_speed"][j] = kink_speed
+    for key in ("v_plan", "length", "trim1", "trim2"):
+        out[key][j] = blend[key]
+    return out
+
+
+def _candidate_blends(
+    moves: Toolpath,
+    j: np.ndarray,
+    speed_mm_s: np.ndarray,
+    tol_mm: np.ndarray,
+    axis_acc_mm_s2: np.ndarray,
+    axis_vel_mm_s: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """:func:`arc_junction_blends` at the K junctions ``j`` (after moves ``j``), shapes (K,);
+    an arc shortened at its start by the blend before it keeps the rest of its sweep."""
+    m = len(moves)
+    arc = moves.is_arc
     point = moves.end_mm[j]
     u1, u2 = moves.end_tangents[j], moves.start_tangents[j + 1]
     normal_axis = moves._plane_axes[:, 2]
@@ -508,44 +583,48 @@ def arc_junctions(
     centre2[rows, normal_axis[j + 1]] = point[rows, normal_axis[j + 1]]
     sweep = np.abs(moves.sweep_rad)
     length = moves.lengths_mm
-    plane_acc = blend_plane_acc(u1, u2, axis_acc_mm_s2)
-    plane_vel = blend_plane_acc(u1, u2, axis_vel_mm_s)
-    args = (point, u1, u2, arc[j], arc[j + 1], centre1, centre2, normal[j], normal[j + 1])
-    rest = (length[j], length[j + 1], speed_mm_s[j], speed_mm_s[j + 1], tol_mm[j], plane_acc,
-            plane_vel)  # fmt: skip
-    blend = arc_junction_blends(*args, sweep[j], sweep[j + 1], *rest)
-    # an arc shortened at its start by the blend before it keeps the rest of its sweep
+    same = {
+        "point": point, "u1": u1, "u2": u2, "arc1": arc[j], "arc2": arc[j + 1],
+        "centre1": centre1, "centre2": centre2, "normal1": normal[j], "normal2": normal[j + 1],
+        "length1": length[j], "length2": length[j + 1],
+        "speed1": speed_mm_s[j], "speed2": speed_mm_s[j + 1], "tol_mm": tol_mm[j],
+        "plane_acc": blend_plane_acc(u1, u2, axis_acc_mm_s2),
+        "plane_vel": blend_plane_acc(u1, u2, axis_vel_mm_s),
+    }  # fmt: skip
+    blend = arc_junction_blends(**same, sweep1=sweep[j], sweep2=sweep[j + 1])
     start_trim = np.zeros(m)
     start_trim[j + 1] = np.where(arc[j + 1], blend["trim2"] / moves.radius_mm[j + 1], 0.0)
     again = np.flatnonzero(start_trim[j] > 0)
     if len(again):
         sub = arc_junction_blends(
-            *(a[again] for a in args), (sweep[j] - start_trim[j])[again], sweep[j + 1][again],
-            *(a[again] for a in rest),
-        )  # fmt: skip
+            **{key: value[again] for key, value in same.items()},
+            sweep1=(sweep[j] - start_trim[j])[again],
+            sweep2=sweep[j + 1][again],
+        )
         for key, value in sub.items():
             blend[key][again] = value
-    # a line's remainder passed in under GAP_CYCLES periods at the planned speed joins the
-    # blend arc before the choice (blendCheckConsume, arcFromBlendPoints3's line_length)
-    rest1 = length[j] - start_trim_mm[j] - blend["trim1"]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        consumed = ~arc[j] & blend["made"] & (rest1 < GAP_CYCLES * period_s * blend["v_plan"])
-    blend_len = blend["length"] + np.where(consumed, rest1, 0.0)
-    arc_speed = np.minimum(blend["v_plan"], blend_len / period_s)
-    kink_speed = np.minimum(speed_mm_s[j], speed_mm_s[j + 1]) * KINK_RATIO / kink_share[j]
-    # parabolic end (1/2), kink (1 - r_k), and 1/2 on an arc not yet finalized
+    return blend
+
+
+def _parabolic_measure(
+    moves: Toolpath,
+    j: np.ndarray,
+    speed_mm_s: np.ndarray,
+    req_speed_mm_s: np.ndarray,
+    path_acc_mm_s2: np.ndarray,
+    tol_mm: np.ndarray,
+    arc_rules: bool,
+) -> np.ndarray:
+    """:func:`parabolic_performance` at the K junctions ``j``, shape (K,): the angle of the
+    parabolic blend from its own directions, the moves at their overall acceleration then
+    (their parabolic end, 1/2, the kink, :math:`1 - r_k`, and 1/2 on an arc not yet
+    finalized)."""
+    arc, length = moves.is_arc, moves.lengths_mm
     scale = 0.5 * (1.0 - KINK_RATIO)
     acc1 = path_acc_mm_s2[j] * scale * np.where(arc[j], 0.5, 1.0)
     acc2 = path_acc_mm_s2[j + 1] * scale * np.where(arc[j + 1], 0.5, 1.0)
-    # the angle of the parabolic blend from its own directions, the next move at its
-    # overall acceleration then (its parabolic end and the kink)
     d_end, d_start = parabolic_directions(moves, path_acc_mm_s2 * scale, req_speed_mm_s, arc_rules)
-    parabolic = parabolic_performance(
+    return parabolic_performance(
         length[j], length[j + 1], speed_mm_s[j], speed_mm_s[j + 1], acc1, acc2,
         np.einsum("ij,ij->i", d_end[j], d_start[j + 1]), tol_mm[j],
     )  # fmt: skip
-    out["choice"][j] = choose_blends(np.where(blend["made"], arc_speed, 0.0), kink_speed, parabolic)
-    out["kink_speed"][j] = kink_speed
-    for key in ("v_plan", "length", "trim1", "trim2"):
-        out[key][j] = blend[key]
-    return out

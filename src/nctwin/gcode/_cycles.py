@@ -83,6 +83,73 @@ class _Sticky:
     ijk: tuple[float, float, float] = (np.nan, np.nan, np.nan)
 
 
+@dataclass(frozen=True)
+class _Anchors:
+    """Where the positions of n lines are anchored (n, 3): the G53 lines (n,), the axes G92
+    sets, the machine coordinate of G28/G30 (NaN elsewhere) and where one is given, the
+    anchors, the incremental steps and their sums, the last anchor at or before each line, the
+    program coordinate of each anchor (mm) and in its line's units where exact, and the count
+    of steps so far."""
+
+    g53: np.ndarray
+    g92: np.ndarray
+    target: np.ndarray
+    home: np.ndarray
+    anchor: np.ndarray
+    step: np.ndarray
+    csum: np.ndarray
+    last: np.ndarray
+    aval: np.ndarray
+    uval: np.ndarray
+    n_steps: np.ndarray
+
+    @classmethod
+    def of(cls, L: _Lines, axis_given, axis_val, hl, home_mm, cycle_line) -> _Anchors:
+        n = len(L.scale)
+        nonmodal = L.G[_NONMODAL]
+        g53 = nonmodal == 530  # machine coordinates: program coordinates minus the G92 offset
+        g92 = np.stack([L.has[x] for x in "XYZ"], axis=1) & (nonmodal == 920)[:, None]
+        target = np.full((n, 3), np.nan)  # the machine coordinates of G28/G30 (NaN elsewhere)
+        target[hl] = home_mm
+        home = ~np.isnan(target)
+        anchor = (
+            (axis_given & ~L.incremental[:, None])
+            | (cycle_line | _IS_G92[nonmodal] & (nonmodal != 920))[:, None]  # every axis moves
+            | g92
+            | home
+        )
+        step = np.where(axis_given & L.incremental[:, None] & ~cycle_line[:, None], axis_val, 0.0)
+        last = np.where(anchor, np.arange(n)[:, None], -1)
+        np.maximum.accumulate(last, axis=0, out=last)
+        uval = np.stack([L.W[x] for x in "XYZ"], axis=1)  # ... in its line's units, where exact
+        uval[g53] = np.nan
+        uval[home] = np.nan
+        return cls(
+            g53, g92, target, home, anchor, step, np.cumsum(step, axis=0), last,
+            np.where(home, target, axis_val), uval, np.cumsum(step != 0.0, axis=0),
+        )  # fmt: skip
+
+    def before(self, k: int, start: np.ndarray) -> np.ndarray:
+        """Program coordinates before line k."""
+        p = start.copy()
+        for a in range(3):
+            j = self.last[k - 1, a] if k else -1
+            if j >= 0:
+                p[a] = self.aval[j, a] + (self.csum[k - 1, a] - self.csum[j, a])
+            elif k:
+                p[a] = start[a] + (self.csum[k - 1, a] - 0.0)
+        return p
+
+    def in_units(self, k: int, cur: np.ndarray, scale: np.ndarray) -> np.ndarray:
+        """Program coordinates ``cur`` (mm) before line k, in its units, exactly where known."""
+        u = cur / scale[k]
+        for a in range(3):
+            j = self.last[k - 1, a] if k else -1
+            if j >= 0 and self.n_steps[k - 1, a] == self.n_steps[j, a] and scale[j] == scale[k]:
+                u[a] = u[a] if np.isnan(self.uval[j, a]) else self.uval[j, a]
+        return u
+
+
 def _special_positions(
     L: _Lines, axis_given, axis_val, hl, home_mm, cycle_line, moves, start, errors, cycles
 ):
@@ -103,73 +170,17 @@ def _special_positions(
     """
     n = len(L.scale)
     nonmodal = L.G[_NONMODAL]
-    g53 = nonmodal == 530  # machine coordinates: program coordinates minus the G92 offset
-    g92 = np.stack([L.has[x] for x in "XYZ"], axis=1) & (nonmodal == 920)[:, None]
-    target = np.full((n, 3), np.nan)  # the machine coordinates of G28/G30 (NaN elsewhere)
-    target[hl] = home_mm
-    home = ~np.isnan(target)
-    anchor = (
-        (axis_given & ~L.incremental[:, None])
-        | (cycle_line | _IS_G92[nonmodal] & (nonmodal != 920))[:, None]  # every axis moves
-        | g92
-        | home
-    )
-    step = np.where(axis_given & L.incremental[:, None] & ~cycle_line[:, None], axis_val, 0.0)
-    csum = np.cumsum(step, axis=0)
-    last = np.where(anchor, np.arange(n)[:, None], -1)
-    np.maximum.accumulate(last, axis=0, out=last)
-    aval = np.where(home, target, axis_val)  # the program coordinate of each anchor
-    uval = np.stack([L.W[x] for x in "XYZ"], axis=1)  # ... in its line's units, where exact
-    uval[g53] = np.nan
-    uval[home] = np.nan
-    n_steps = np.cumsum(step != 0.0, axis=0)
+    an = _Anchors.of(L, axis_given, axis_val, hl, home_mm, cycle_line)
+    aval, uval = an.aval, an.uval  # filled in as the loop goes
     off = np.zeros((n, 3))  # the G92 offsets in force at each line
-
-    def before(k: int) -> np.ndarray:
-        """Program coordinates before line k."""
-        p = start.copy()
-        for a in range(3):
-            j = last[k - 1, a] if k else -1
-            if j >= 0:
-                p[a] = aval[j, a] + (csum[k - 1, a] - csum[j, a])
-            elif k:
-                p[a] = start[a] + (csum[k - 1, a] - 0.0)
-        return p
-
-    def in_units(k: int, cur: np.ndarray) -> np.ndarray:
-        """Program coordinates ``cur`` (mm) before line k, in its units, exactly where known."""
-        u = cur / L.scale[k]
-        for a in range(3):
-            j = last[k - 1, a] if k else -1
-            if j >= 0 and n_steps[k - 1, a] == n_steps[j, a] and L.scale[j] == L.scale[k]:
-                u[a] = u[a] if np.isnan(uval[j, a]) else uval[j, a]
-        return u
-
     # a motion other than a canned cycle resets the cycles' initial level
     resets = np.cumsum((L.G[_MOTION] >= 0) & ~_IS_CYCLE[L.G[_MOTION]] | (moves & ~cycle_line))
     o, saved = np.zeros(3), np.zeros(3)  # G92 offsets, and parameters 5211-5213 (mm)
     il, sticky, last_cycle = None, _Sticky(), -1
     for k in np.flatnonzero(cycle_line | _IS_G92[nonmodal]):
-        cur = before(k)
-        if _IS_G92[nonmodal[k]]:  # interp_convert.cc, convert_axis_offsets
-            if nonmodal[k] == 920:  # the current point gets the given coordinates
-                new = (cur + o) - axis_val[k]
-                o = np.where(g92[k], new, o)
-                saved = o.copy()
-                cur = np.where(g92[k], axis_val[k], cur)
-            elif nonmodal[k] == 923:  # back to the offsets kept in the parameters
-                cur = (cur + o) - saved
-                o = saved.copy()
-            else:  # G92.1 clears the parameters too, G92.2 keeps them
-                cur = cur + o
-                o = np.zeros(3)
-                saved = saved if nonmodal[k] == 922 else np.zeros(3)
-            off[k:] = o
-            aval[k:][g53[k:]] = axis_val[k:][g53[k:]] - o
-            aval[k:][home[k:]] = (target[k:] - o)[home[k:]]
-            aval[k] = cur
-            if nonmodal[k] != 920:
-                uval[k] = np.nan
+        cur = an.before(k, start)
+        if _IS_G92[nonmodal[k]]:
+            cur, o, saved = _g92_line(L, k, an, cur, o, saved, off, axis_val, axis_given)
             if not cycle_line[k]:  # the motion of the line, after the offsets
                 given = axis_given[k]
                 aval[k, given] = np.where(
@@ -180,7 +191,7 @@ def _special_positions(
         if cycle_line[k]:
             if last_cycle >= 0 and resets[k - 1] > resets[last_cycle]:
                 il = None
-            units = cur / L.scale[k] if _IS_G92[nonmodal[k]] else in_units(k, cur)
+            units = cur / L.scale[k] if _IS_G92[nonmodal[k]] else an.in_units(k, cur, L.scale)
             try:
                 blocks, uval[k], il, sticky = _cycle(L, k, units, off[k], il, sticky)
             except _LineError as exc:
@@ -192,10 +203,58 @@ def _special_positions(
             last_cycle = k
     pos = np.empty((n, 3))
     for a in range(3):
-        prog = _anchored(anchor[:, a], aval[:, a], step[:, a], start[a])
+        prog = _anchored(an.anchor[:, a], aval[:, a], an.step[:, a], start[a])
         # a line without motion leaves the tool where it is, whatever its offsets
-        pos[:, a] = _ffill(moves | home.any(1), prog + off[:, a], start[a])
+        pos[:, a] = _ffill(moves | an.home.any(1), prog + off[:, a], start[a])
     return pos, off
+
+
+def _g92_line(L: _Lines, k: int, an: _Anchors, cur, o, saved, off, axis_val, axis_given):
+    """The G92 family at line ``k`` (interp_convert.cc, ``convert_axis_offsets``): the offsets
+    from line ``k`` on go to ``off`` and the anchors' values are updated; returns the program
+    coordinates at the line, the offsets (3,) and parameters 5211-5213 (3,) (mm)."""
+    nonmodal = L.G[_NONMODAL]
+    g53, home = an.g53, an.home
+    if nonmodal[k] == 920:  # the current point gets the given coordinates
+        new = (cur + o) - axis_val[k]
+        o = np.where(an.g92[k], new, o)
+        saved = o.copy()
+        cur = np.where(an.g92[k], axis_val[k], cur)
+    elif nonmodal[k] == 923:  # back to the offsets kept in the parameters
+        cur = (cur + o) - saved
+        o = saved.copy()
+    else:  # G92.1 clears the parameters too, G92.2 keeps them
+        cur = cur + o
+        o = np.zeros(3)
+        saved = saved if nonmodal[k] == 922 else np.zeros(3)
+    off[k:] = o
+    an.aval[k:][g53[k:]] = axis_val[k:][g53[k:]] - o
+    an.aval[k:][home[k:]] = (an.target[k:] - o)[home[k:]]
+    an.aval[k] = cur
+    if nonmodal[k] != 920:
+        an.uval[k] = np.nan
+    return cur, o, saved
+
+
+@dataclass(frozen=True)
+class _CycleWords:
+    """A canned cycle's line as read, in program units: its code (ten times the G number) and
+    name, R and the depth as given or kept, the R plane and the bottom, the first hole's
+    coordinates on the plane's two axes and the step between repeats (0 in G90), the dwell P
+    (s), Q and G87's I, J, K."""
+
+    c: int
+    name: str
+    r_word: float
+    depth: float
+    r: float
+    bottom: float
+    aa: float
+    bb: float
+    step: list
+    p: float
+    q: float
+    ijk: tuple
 
 
 def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
@@ -232,8 +291,17 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
     _LineError
         With LinuxCNC's reason, where it refuses the line.
     """
+    w, il = _cycle_words(L, k, cur, il, sticky)
+    repeats = _cycle_repeats(L, k, w)
+    blocks, end = _cycle_blocks(L, k, w, repeats, cur, off, il)
+    sticky = replace(sticky, r=w.r_word, depth=w.depth, p=w.p, q=w.q, ijk=w.ijk)
+    return blocks, end, il, sticky
+
+
+def _cycle_words(L: _Lines, k: int, cur, il, sticky: _Sticky) -> tuple[_CycleWords, float]:
+    """The words of the canned cycle of line ``k`` (those of the same cycle on the line before
+    carry over), and the initial level."""
     c, name = int(L.motion[k]), _fmt_g(int(L.motion[k]))
-    s = float(L.scale[k])
     a, b, nrm = PLANE_AXES[L.plane[k]]
     W = {x: float(L.W[x][k]) for x in "XYZIJKRPQL"}
     has = {x: bool(L.has[x][k]) for x in "XYZIJKRPQL"}
@@ -256,10 +324,9 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
     depth = word(depth_letter, sticky.depth, f"{depth_letter} value unspecified in {name}")
     if il is None:
         il = float(cur[nrm])
-    old = il
     if L.incremental[k]:
         step = [W["XYZ"[x]] if has["XYZ"[x]] else 0.0 for x in (a, b)]
-        r = r_word + old
+        r = r_word + il
         bottom = r + depth
         aa, bb = float(cur[a]), float(cur[b])
     else:
@@ -283,6 +350,12 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
         ijk = tuple(
             word(x, v, f"{x} word missing with G87") for x, v in zip("IJK", ijk, strict=True)
         )
+    return _CycleWords(c, name, r_word, depth, r, bottom, aa, bb, step, p, q, ijk), il
+
+
+def _cycle_repeats(L: _Lines, k: int, w: _CycleWords) -> int:
+    """The spindle a cycle needs and its repeats (L), refused where LinuxCNC refuses them."""
+    c, name = w.c, w.name
     spindle = L.spindle[k]
     if L.rigid is not None and L.rigid[k]:  # rigid tapping: the control turns the spindle
         spindle = 1 if c == 840 else -1
@@ -291,23 +364,31 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
     if (c, spindle) in ((840, -1), (740, 1)):
         turning = "counterclockwise" if spindle == -1 else "clockwise"
         raise _LineError(f"spindle turning {turning} in {name}")
-    repeats = int(np.rint(W["L"])) if has["L"] else 1
-    per_repeat = 12 + (3 * (r - bottom) / q if c in (730, 830) else 0)
-    values = (r, bottom, aa, bb, *step, per_repeat)
+    repeats = int(np.rint(float(L.W["L"][k]))) if bool(L.has["L"][k]) else 1
+    per_repeat = 12 + (3 * (w.r - w.bottom) / w.q if c in (730, 830) else 0)
+    values = (w.r, w.bottom, w.aa, w.bb, *w.step, per_repeat)
     if not (np.isfinite(values).all() and repeats * per_repeat <= MAX_BLOCKS_PER_LINE):
         raise _LineError(f"{name} would make more than {MAX_BLOCKS_PER_LINE} moves")
+    return repeats
 
+
+def _cycle_blocks(L: _Lines, k: int, w: _CycleWords, repeats: int, cur, off, old: float):
+    """The blocks of a cycle's holes (the CYCLE_MACRO loop) from the initial level ``old``,
+    and the program coordinates after them."""
+    s = float(L.scale[k])
+    a, b, nrm = PLANE_AXES[L.plane[k]]
+    r = w.r
     blocks = []
     at = np.zeros(3)  # program coordinates of the last point
 
-    def go(kind: MotionKind, u: float, v: float, w: float, exact: bool = True) -> None:
-        at[[a, b, nrm]] = u, v, w
+    def go(kind: MotionKind, u: float, v: float, h: float, exact: bool = True) -> None:
+        at[[a, b, nrm]] = u, v, h
         blocks.append((kind, at * s + off, 0.0, exact))
 
     def dwell(t: float) -> None:
         blocks.append((MotionKind.DWELL, at * s + off, t, True))
 
-    rapid, feed = MotionKind.RAPID, MotionKind.LINEAR
+    rapid = MotionKind.RAPID
     current = float(cur[nrm])
     at[:] = cur
     if old < r:  # below the R plane: straight up to it first (before the exact-path mode is set)
@@ -315,8 +396,9 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
         old = current = r
     clear = r if L.retract_r[k] else old
     delta = G83_RAPID_DELTA_IN * (1.0 if s == MM_PER_INCH else MM_PER_INCH)
+    aa, bb = w.aa, w.bb
     for repeat in range(repeats):  # CYCLE_MACRO
-        aa, bb = aa + step[0], bb + step[1]
+        aa, bb = aa + w.step[0], bb + w.step[1]
         if repeat == 0 and current > r:
             go(rapid, aa, bb, current)
             go(rapid, aa, bb, r)
@@ -324,47 +406,54 @@ def _cycle(L: _Lines, k: int, cur, off, il, sticky: _Sticky):
             go(rapid, aa, bb, clear)
             if clear > r:
                 go(rapid, aa, bb, r)
-        if c in (730, 830):  # peck drilling: chip breaking (G73) or full retract (G83)
-            depth_now = r - q
-            while depth_now > bottom:
-                go(feed, aa, bb, depth_now)
-                if c == 830:
-                    go(rapid, aa, bb, r)
-                go(rapid, aa, bb, depth_now + delta)
-                depth_now = depth_now - q
-            go(feed, aa, bb, bottom)
-            go(rapid, aa, bb, clear)
-        elif c == 760:  # Fanuc fine boring (see the module docstring)
-            go(feed, aa, bb, bottom)
-            if p > 0:
-                dwell(p)
-            if q > 0:  # the oriented stop (M19) takes no time here; the shift is a rapid
-                go(rapid, aa + q, bb, bottom)
-            go(rapid, aa + q, bb, clear)
-            if q > 0:  # shift back, then the spindle restarts (no time here either)
-                go(rapid, aa, bb, clear)
-        elif c == 870:  # back boring, in and out off centre by I/J with the spindle oriented
-            oa, ob = aa + ijk[a], bb + ijk[b]
-            middle = ijk[nrm] + (bottom if L.incremental[k] else 0.0)
-            go(rapid, oa, ob, r)
-            go(rapid, oa, ob, bottom)
-            go(rapid, aa, bb, bottom)
-            go(feed, aa, bb, middle)
-            go(feed, aa, bb, bottom)
-            go(rapid, oa, ob, bottom)
-            go(rapid, oa, ob, clear)
-            go(rapid, aa, bb, clear)
-        else:
-            go(feed, aa, bb, bottom)
-            if c == 850:  # feed out to R, then rapid
-                go(feed, aa, bb, r)
-            if _DWELLS[c]:
-                dwell(p)
-            if c in (740, 840, 890):  # tapping and boring: feed out
-                go(feed, aa, bb, clear)
-            elif c != 880:  # G88: the operator takes the tool out at a program stop
-                go(rapid, aa, bb, clear)
+        _hole(w, go, dwell, aa, bb, clear, delta, (a, b, nrm), bool(L.incremental[k]))
     end = np.zeros(3)
     end[[a, b, nrm]] = aa, bb, clear
-    sticky = replace(sticky, r=r_word, depth=depth, p=p, q=q, ijk=ijk)
-    return blocks, end, il, sticky
+    return blocks, end
+
+
+def _hole(w: _CycleWords, go, dwell, aa, bb, clear, delta, axes, incremental) -> None:
+    """One hole of a cycle from its R plane down and out to ``clear``, by the cycle's kind."""
+    c, r, bottom, p, q = w.c, w.r, w.bottom, w.p, w.q
+    rapid, feed = MotionKind.RAPID, MotionKind.LINEAR
+    if c in (730, 830):  # peck drilling: chip breaking (G73) or full retract (G83)
+        depth_now = r - q
+        while depth_now > bottom:
+            go(feed, aa, bb, depth_now)
+            if c == 830:
+                go(rapid, aa, bb, r)
+            go(rapid, aa, bb, depth_now + delta)
+            depth_now = depth_now - q
+        go(feed, aa, bb, bottom)
+        go(rapid, aa, bb, clear)
+    elif c == 760:  # Fanuc fine boring (see the module docstring)
+        go(feed, aa, bb, bottom)
+        if p > 0:
+            dwell(p)
+        if q > 0:  # the oriented stop (M19) takes no time here; the shift is a rapid
+            go(rapid, aa + q, bb, bottom)
+        go(rapid, aa + q, bb, clear)
+        if q > 0:  # shift back, then the spindle restarts (no time here either)
+            go(rapid, aa, bb, clear)
+    elif c == 870:  # back boring, in and out off centre by I/J with the spindle oriented
+        a, b, nrm = axes
+        oa, ob = aa + w.ijk[a], bb + w.ijk[b]
+        middle = w.ijk[nrm] + (bottom if incremental else 0.0)
+        go(rapid, oa, ob, r)
+        go(rapid, oa, ob, bottom)
+        go(rapid, aa, bb, bottom)
+        go(feed, aa, bb, middle)
+        go(feed, aa, bb, bottom)
+        go(rapid, oa, ob, bottom)
+        go(rapid, oa, ob, clear)
+        go(rapid, aa, bb, clear)
+    else:
+        go(feed, aa, bb, bottom)
+        if c == 850:  # feed out to R, then rapid
+            go(feed, aa, bb, r)
+        if _DWELLS[c]:
+            dwell(p)
+        if c in (740, 840, 890):  # tapping and boring: feed out
+            go(feed, aa, bb, clear)
+        elif c != 880:  # G88: the operator takes the tool out at a program stop
+            go(rapid, aa, bb, clear)

@@ -4,6 +4,7 @@ execution within a line, the arcs, and the blocks of each line, as a
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 
@@ -175,7 +176,91 @@ def _interpret(
     program is in the fanuc dialect.
     """
     code, value, line = words["code"], words["value"], words["line"]
-    # ---- one value per line and letter; a letter twice in a line is an error (not G, M)
+    W, has = _single_words(code, value, line, n, errors)
+    G = _g_codes(words, n, errors, fanuc)
+    st = _modal_state(W, has, G, n, inch, errors)
+    dwell_t, fanuc_dwell = _dwells(W, has, G, st, p_scale, errors)
+    act = _line_actions(W, has, G, st, fanuc_dwell, references, errors)
+    rigid = None
+    if fanuc:  # M29 rigid tapping; M98/M99 and K repeats refused
+        rigid = _fanuc_words(code, value, line, has, G, st.motion, act.cycle_line, errors)
+    turns = _motion_words(W, has, st, act, n, fanuc, errors)
+    # ---- positions (machine coordinates: program coordinates plus the G92 offsets); a G28/G30
+    # line ends with its axes at the reference point, whatever the offsets
+    axis_val = np.stack([W["X"], W["Y"], W["Z"]], axis=1) * st.scale[:, None]
+    special = act.cycle_line | _IS_G92[G[_NONMODAL]]
+    cycles: dict[int, list] = {}
+    hl, home_mm = act.home_lines, act.home_mm
+    if special.any():
+        L = _Lines(
+            W, has, G, st.scale, st.motion, st.plane, st.incremental,
+            _ffill(G[_RETRACT] >= 0, G[_RETRACT] == 990, True),
+            _spindle(code, value, line, n), p_scale, rigid,
+        )  # fmt: skip
+        pos, off = _special_positions(
+            L, act.axis_given, axis_val, hl, home_mm, act.cycle_line, act.moves, start, errors,
+            cycles,
+        )  # fmt: skip
+    else:
+        pos, off = _plain_positions(act, axis_val, st.incremental, start, n)
+    prev = np.vstack([start, pos[:-1]]) if n else pos
+    # the intermediate point of each G28/G30 line: its axis words in the distance mode in force
+    to = np.where(st.incremental[hl, None], prev[hl] + axis_val[hl], axis_val[hl] + off[hl])
+    via = np.where(act.named, to, prev[hl])
+    # ---- arcs
+    center = np.full((n, 3), np.nan)
+    ai = np.flatnonzero(act.arc_line)
+    if len(ai):
+        center[ai] = _arc_centers(
+            ai, prev, pos, st.plane, st.motion, W, has, st.scale, st.arc_absolute, off, errors,
+            arc_tol,
+        )  # fmt: skip
+    blocks = _line_blocks(st, act, start, prev, pos, center, turns, via, dwell_t, cycles)
+    return _toolpath(words, st, blocks)
+
+
+@dataclass(frozen=True)
+class _Modal:
+    """The modal state in force at each of n lines, after the line's own codes, shapes (n,):
+    mm per program unit, the motion code, the plane, G91, G91.1, the path-control code, and
+    the lines with G64, G4 and G92; the feed (mm/s, NaN: none), the path mode and G64's P and
+    Q (mm, NaN outside G64)."""
+
+    scale: np.ndarray
+    motion: np.ndarray
+    plane: np.ndarray
+    incremental: np.ndarray
+    arc_absolute: np.ndarray
+    g64: np.ndarray
+    dwell_line: np.ndarray
+    g92_line: np.ndarray
+    feed: np.ndarray
+    mode: np.ndarray
+    blend_p: np.ndarray
+    blend_q: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Actions:
+    """What each of n lines does: the axes it names (n, 3), whether it names any, arcs,
+    canned cycles, moves; its G28/G30 return (``home_lines``, H of them, the axes their words
+    name (H, 3) and the reference point, NaN for the axes that stay), and the words I, J, K."""
+
+    axis_given: np.ndarray
+    any_axis: np.ndarray
+    arc_line: np.ndarray
+    cycle_line: np.ndarray
+    moves: np.ndarray
+    home_line: np.ndarray
+    home_lines: np.ndarray
+    named: np.ndarray
+    home_mm: np.ndarray
+    ijk: np.ndarray
+
+
+def _single_words(code, value, line, n, errors: _Errors) -> tuple[dict, dict]:
+    """One value per line and letter; a letter twice in a line is an error (not G, M).
+    Returns each letter's value per line (NaN where absent) and its presence, shapes (n,)."""
     row = _ROW[code]
     single = row >= 0
     key = line[single] * len(_SINGLE) + row[single]
@@ -187,9 +272,14 @@ def _interpret(
     table[row[single], line[single]] = value[single]
     W = dict(zip(_SINGLE, table, strict=True))
     has = dict(zip(_SINGLE, ~np.isnan(table), strict=True))
+    return W, has
 
-    # ---- G-codes: one per modal group and line
-    g = code == _L["G"]
+
+def _g_codes(words, n, errors: _Errors, fanuc) -> np.ndarray:
+    """G-codes: one per modal group and line; the code (ten times its number) of each group
+    on each line, -1 where none, shape (groups, n)."""
+    value, line = words["value"], words["line"]
+    g = words["code"] == _L["G"]
     gval, gline = value[g], line[g]
     gcode = np.rint(gval * 10).astype(np.int64)
     codes, groups = (_G_CODES_FANUC, _G_GROUPS_FANUC) if fanuc else (_G_CODES, _G_GROUPS)
@@ -217,24 +307,19 @@ def _interpret(
     )
     G = np.full((n_groups, n), -1, dtype=np.int64)
     G[grp, gline] = gcode
+    return G
 
-    # ---- modal state per line (after the line's own codes, which run before its motion)
+
+def _modal_state(W, has, G, n, inch, errors: _Errors) -> _Modal:
+    """The modal state per line (after the line's own codes, which run before its motion)."""
     scale = np.where(_ffill(G[_UNITS] >= 0, G[_UNITS] == 200, inch), MM_PER_INCH, 1.0)
-    motion = _ffill(G[_MOTION] >= 0, G[_MOTION], -1)
-    plane = _ffill(G[_PLANE] >= 0, (G[_PLANE] - 170) // 10, int(Plane.XY))
-    incremental = _ffill(G[_DIST] >= 0, G[_DIST] == 910, False)
-    arc_absolute = _ffill(G[_ARCDIST] >= 0, G[_ARCDIST] == 901, False)
     path_code = _ffill(G[_PATH] >= 0, G[_PATH], -1)
     g64 = G[_PATH] == 640
-    dwell_line = G[_NONMODAL] == 40
-    g92_line = G[_NONMODAL] == 920
-
     # F runs before the line's G20/G21, and a change of units keeps the feed in mm/min; G94
     # runs before F and sets the feed to 0, no feed (LinuxCNC's convert_feed_mode)
     errors.at_lines(has["F"] & (W["F"] <= 0), "feed rate F must be > 0")
     scale_before = np.concatenate([[MM_PER_INCH if inch else 1.0], scale[:-1]])
     feed = _ffill(has["F"] | (G[_FEEDMODE] == 940), W["F"] * scale_before / 60.0, np.nan)
-
     errors.at_lines(has["H"] & (G[_TLO] != 430), "H word without G43")
     errors.at_lines(g64 & ((W["P"] < 0) | (W["Q"] < 0)), "G64 P and Q must be >= 0")
     mode = np.select(
@@ -246,13 +331,31 @@ def _interpret(
     blend_q = _ffill(g64, W["Q"] * scale, np.nan)
     blend_p[mode != PathMode.BLEND] = np.nan
     blend_q[mode != PathMode.BLEND] = np.nan
+    return _Modal(
+        scale=scale,
+        motion=_ffill(G[_MOTION] >= 0, G[_MOTION], -1),
+        plane=_ffill(G[_PLANE] >= 0, (G[_PLANE] - 170) // 10, int(Plane.XY)),
+        incremental=_ffill(G[_DIST] >= 0, G[_DIST] == 910, False),
+        arc_absolute=_ffill(G[_ARCDIST] >= 0, G[_ARCDIST] == 901, False),
+        g64=g64,
+        dwell_line=G[_NONMODAL] == 40,
+        g92_line=G[_NONMODAL] == 920,
+        feed=feed,
+        mode=mode,
+        blend_p=blend_p,
+        blend_q=blend_q,
+    )
 
-    # ---- dwells: P, or X alone (Fanuc), which is then no axis word
+
+def _dwells(W, has, G, st: _Modal, p_scale, errors: _Errors) -> tuple[np.ndarray, np.ndarray]:
+    """Dwells: P, or X alone (Fanuc), which is then no axis word. Returns each line's dwell
+    time (s) and the lines whose X is a dwell time, shapes (n,)."""
+    dwell_line = st.dwell_line
     fanuc_dwell = dwell_line & ~has["P"] & has["X"]
     dwell_t = np.where(has["P"], W["P"] * p_scale, W["X"])
     ijk = has["I"] | has["J"] | has["K"]
     errors.at_lines(dwell_line & ~has["P"] & ~has["X"], "G4 without a dwell time (P)")
-    errors.at_lines(dwell_line & has["P"] & g64, "P word used by both G4 and G64")
+    errors.at_lines(dwell_line & has["P"] & st.g64, "P word used by both G4 and G64")
     errors.at_lines(
         dwell_line & _IS_ARC[G[_MOTION]], "G4 cannot share a line with G2/G3: both use P"
     )
@@ -261,9 +364,14 @@ def _interpret(
         fanuc_dwell & (has["Y"] | has["Z"] | ijk | has["R"] | (G[_MOTION] >= 0)),
         "G4 with X as its time cannot share a line with motion: give the dwell time with P",
     )
+    return dwell_t, fanuc_dwell
 
-    # ---- what each line does: its motion (the modal one, if it has axis words), G92, or a
-    # G28/G30 return, which leaves the motion mode as it is
+
+def _line_actions(W, has, G, st: _Modal, fanuc_dwell, references, errors: _Errors) -> _Actions:
+    """What each line does: its motion (the modal one, if it has axis words), G92, or a
+    G28/G30 return, which leaves the motion mode as it is."""
+    motion = st.motion
+    ijk = has["I"] | has["J"] | has["K"]
     axis_given = np.stack([has["X"] & ~fanuc_dwell, has["Y"], has["Z"]], axis=1)
     # the G28/G30 lines (few, hl): their axis words give the intermediate point, then the axes
     # they name (all, if none) go to the reference point, home_mm (NaN for the axes that stay)
@@ -273,7 +381,7 @@ def _interpret(
     home_mm = np.where(
         named | ~named.any(1)[:, None], references[(G[_NONMODAL, hl] == 300).astype(int)], np.nan
     )
-    axis_given[g92_line] = False  # G92 takes the axis words as the current position
+    axis_given[st.g92_line] = False  # G92 takes the axis words as the current position
     axis_given[hl] = False
     any_axis = axis_given.any(1)
     arc_line = _IS_ARC[motion] & (any_axis | ijk)
@@ -285,10 +393,10 @@ def _interpret(
         "axis words without an active motion mode (G0/G1/G2/G3 or a canned cycle)",
     )
     errors.at_lines(
-        g92_line & ~(has["X"] | has["Y"] | has["Z"]), "G92 without an axis word (X, Y or Z)"
+        st.g92_line & ~(has["X"] | has["Y"] | has["Z"]), "G92 without an axis word (X, Y or Z)"
     )
     errors.at_lines(
-        (g92_line | home_line) & (G[_MOTION] >= 0) & (G[_MOTION] != 800),
+        (st.g92_line | home_line) & (G[_MOTION] >= 0) & (G[_MOTION] != 800),
         lambda i: (
             f"{_fmt_g(int(G[_NONMODAL, i]))} and {_fmt_g(int(G[_MOTION, i]))} cannot share a"
             " line: both use the axis words"
@@ -302,26 +410,29 @@ def _interpret(
     errors.at_lines(cycle_line & (G[_NONMODAL] == 530), "G53 can only be used with G0 or G1")
     feed_line = moves & ((motion == 10) | arc_line | cycle_line)
     errors.at_lines(
-        feed_line & np.isnan(feed), lambda i: f"{_fmt_g(int(motion[i]))} with no feed rate set (F)"
+        feed_line & np.isnan(st.feed),
+        lambda i: f"{_fmt_g(int(motion[i]))} with no feed rate set (F)",
+    )
+    return _Actions(
+        axis_given, any_axis, arc_line, cycle_line, moves, home_line, hl, named, home_mm, ijk
     )
 
-    rigid = None
-    if fanuc:  # M29 rigid tapping; M98/M99 and K repeats refused
-        rigid = _fanuc_words(code, value, line, has, G, motion, cycle_line, errors)
 
-    # ---- words that need a motion to use them
-    p_ok = dwell_line | g64 | arc_line | (cycle_line & _DWELLS[motion])
+def _motion_words(W, has, st: _Modal, act: _Actions, n, fanuc, errors: _Errors) -> np.ndarray:
+    """The words that need a motion to use them; returns the turns of each line's arc (n,)."""
+    motion, cycle_line, arc_line = st.motion, act.cycle_line, act.arc_line
+    p_ok = st.dwell_line | st.g64 | arc_line | (cycle_line & _DWELLS[motion])
     errors.at_lines(
         has["P"] & ~p_ok,
         "P word without G2, G3, G4, G64 or a canned cycle that dwells"
         f" (G74{', G76' if fanuc else ''}, G82, G84, G86, G88, G89)",
     )
     errors.at_lines(
-        has["Q"] & ~(g64 | (cycle_line & (_Q_FANUC if fanuc else _PECKS)[motion])),
+        has["Q"] & ~(st.g64 | (cycle_line & (_Q_FANUC if fanuc else _PECKS)[motion])),
         f"Q word without G64, G73{', G76' if fanuc else ''} or G83",
     )
     errors.at_lines(
-        (ijk & ~(arc_line | (cycle_line & (motion == 870))))
+        (act.ijk & ~(arc_line | (cycle_line & (motion == 870))))
         | (has["R"] & ~(arc_line | cycle_line)),
         "I/J/K/R words without an arc (G2/G3) or a canned cycle to use them",
     )
@@ -343,66 +454,52 @@ def _interpret(
             p_turns > MAX_BLOCKS_PER_LINE, f"P value of G2/G3 above {MAX_BLOCKS_PER_LINE} turns"
         )
         turns = np.clip(p_turns, 1, MAX_BLOCKS_PER_LINE).astype(np.int64)
+    return turns
 
-    # ---- positions (machine coordinates: program coordinates plus the G92 offsets); a G28/G30
-    # line ends with its axes at the reference point, whatever the offsets
-    axis_val = np.stack([W["X"], W["Y"], W["Z"]], axis=1) * scale[:, None]
-    special = cycle_line | _IS_G92[G[_NONMODAL]]
-    cycles: dict[int, list] = {}
-    if special.any():
-        L = _Lines(
-            W, has, G, scale, motion, plane, incremental,
-            _ffill(G[_RETRACT] >= 0, G[_RETRACT] == 990, True),
-            _spindle(code, value, line, n), p_scale, rigid,
-        )  # fmt: skip
-        pos, off = _special_positions(
-            L, axis_given, axis_val, hl, home_mm, cycle_line, moves, start, errors, cycles
-        )
-    else:
-        off = np.zeros((n, 3))
-        pos = np.empty((n, 3))
-        for a in range(3):
-            step = np.where(axis_given[:, a] & incremental, axis_val[:, a], 0.0)
-            anchor = axis_given[:, a] & ~incremental
-            value_mm = axis_val[:, a].copy()
-            anchor[hl], value_mm[hl] = ~np.isnan(home_mm[:, a]), home_mm[:, a]
-            pos[:, a] = _anchored(anchor, value_mm, step, start[a])
-    prev = np.vstack([start, pos[:-1]]) if n else pos
-    # the intermediate point of each G28/G30 line: its axis words in the distance mode in force
-    to = np.where(incremental[hl, None], prev[hl] + axis_val[hl], axis_val[hl] + off[hl])
-    via = np.where(named, to, prev[hl])
 
-    # ---- arcs
-    center = np.full((n, 3), np.nan)
-    ai = np.flatnonzero(arc_line)
-    if len(ai):
-        center[ai] = _arc_centers(
-            ai, prev, pos, plane, motion, W, has, scale, arc_absolute, off, errors, arc_tol
-        )
+def _plain_positions(act: _Actions, axis_val, incremental, start, n):
+    """Positions (n, 3) of a program with no canned cycle and no G92, and its offsets (0)."""
+    off = np.zeros((n, 3))
+    pos = np.empty((n, 3))
+    for a in range(3):
+        step = np.where(act.axis_given[:, a] & incremental, axis_val[:, a], 0.0)
+        anchor = act.axis_given[:, a] & ~incremental
+        value_mm = axis_val[:, a].copy()
+        hl = act.home_lines
+        anchor[hl], value_mm[hl] = ~np.isnan(act.home_mm[:, a]), act.home_mm[:, a]
+        pos[:, a] = _anchored(anchor, value_mm, step, start[a])
+    return pos, off
 
-    # ---- blocks: a dwell, then the motion of the line (its turns, or its canned cycle)
-    kind = np.full(n, MotionKind.DWELL, dtype=np.int8)
+
+def _line_blocks(st: _Modal, act: _Actions, start, prev, pos, center, turns, via, dwell_t, cycles):
+    """Blocks: a dwell, then the motion of the line (its turns, or its canned cycle)."""
+    kind = np.full(len(pos), MotionKind.DWELL, dtype=np.int8)
     for c, k in _KIND_OF_MOTION.items():
-        kind[motion == c] = k
-    kind[home_line] = MotionKind.RAPID
-    moves |= home_line
-    simple = moves & ~cycle_line
+        kind[st.motion == c] = k
+    kind[act.home_line] = MotionKind.RAPID
+    moves = act.moves | act.home_line
+    simple = moves & ~act.cycle_line
+    dwell_line, hl = st.dwell_line, act.home_lines
     if cycles or (turns > 1).any() or (dwell_line & moves).any() or len(hl):
-        blocks = _blocks(
-            start, prev, pos, center, plane, kind, simple, turns, hl, via, dwell_line, dwell_t,
-            cycles,
+        return _blocks(
+            start, prev, pos, center, st.plane, kind, simple, turns, hl, via, dwell_line,
+            dwell_t, cycles,
         )  # fmt: skip
-    else:
-        bl = np.flatnonzero(moves | dwell_line)
-        blocks = {
-            "line": bl,
-            "start_mm": prev[bl],
-            "end_mm": pos[bl],  # a dwell line has no axis words: its position is the previous one
-            "kind": np.where(dwell_line[bl], MotionKind.DWELL, kind[bl]).astype(np.int8),
-            "center_mm": center[bl],
-            "dwell_s": np.where(dwell_line[bl], dwell_t[bl], 0.0),
-            "exact": np.zeros(len(bl), dtype=bool),
-        }
+    bl = np.flatnonzero(moves | dwell_line)
+    return {
+        "line": bl,
+        "start_mm": prev[bl],
+        "end_mm": pos[bl],  # a dwell line has no axis words: its position is the previous one
+        "kind": np.where(dwell_line[bl], MotionKind.DWELL, kind[bl]).astype(np.int8),
+        "center_mm": center[bl],
+        "dwell_s": np.where(dwell_line[bl], dwell_t[bl], 0.0),
+        "exact": np.zeros(len(bl), dtype=bool),
+    }
+
+
+def _toolpath(words, st: _Modal, blocks: dict) -> Toolpath:
+    """The Toolpath of the blocks, with the M, S and T words as events."""
+    code, value, line = words["code"], words["value"], words["line"]
     bl = blocks["line"]
     ev = np.isin(code, (_L["M"], _L["S"], _L["T"]))
     events = np.zeros(int(ev.sum()), dtype=EVENT_DTYPE)
@@ -412,16 +509,16 @@ def _interpret(
     events["line"] = line[ev] + 1
     events["word"] = np.array(list(_LETTERS))[code[ev]]
     events["value"] = value[ev]
-    mode, blend_p, blend_q = mode[bl], blend_p[bl], blend_q[bl]
+    mode, blend_p, blend_q = st.mode[bl], st.blend_p[bl], st.blend_q[bl]
     exact = blocks["exact"]  # the moves of canned cycles run in exact-path mode
     mode[exact], blend_p[exact], blend_q[exact] = PathMode.EXACT_PATH, np.nan, np.nan
     return Toolpath(
         start_mm=blocks["start_mm"],
         end_mm=blocks["end_mm"],
         kind=blocks["kind"],
-        feed_mm_s=feed[bl],
+        feed_mm_s=st.feed[bl],
         center_mm=blocks["center_mm"],
-        plane=plane[bl],
+        plane=st.plane[bl],
         dwell_s=blocks["dwell_s"],
         line=bl + 1,
         path_mode=mode,
