@@ -270,6 +270,54 @@ def test_subroutine_called_twice(linuxcnc_interpreter):
     assert tp.line.tolist() == [5, 2, 2]  # the subroutine's line, at each call
 
 
+#: A move between every M-word: M3, M8, M9, M6 run before their line's motion, M0 and M1
+#: after it; the M5 after the tool change changes nothing (M6 stopped the spindle).
+M_WORDS = """G21 G90 F600
+G1 X1
+S1000 M3
+G1 X2
+M8
+G1 X3
+M9
+G1 X4
+T1 M6
+G1 X5
+M0
+G1 X6
+M5
+G1 X7
+M1
+G1 X8
+M7
+G1 X9
+M2
+"""
+
+
+def test_task_words_from_the_modal_state(linuxcnc_interpreter):
+    tp = parse(M_WORDS, reader="linuxcnc")
+    ev = tp.events
+    assert set(ev["word"]) == {"M"}
+    got = list(zip(ev["block"].tolist(), ev["line"].tolist(), ev["value"].tolist(), strict=True))
+    assert got == [(1, 3, 3.0), (2, 5, 8.0), (3, 7, 9.0), (4, 9, 6.0), (5, 11, 0.0), (7, 15, 1.0),
+                   (8, 17, 7.0)]  # fmt: skip
+    # the native reader keeps every word as written: the same, and the M5 and M2 besides
+    native = parse(M_WORDS, reader="native").events
+    native = native[(native["word"] == "M") & ~np.isin(native["value"], (2.0, 5.0))]
+    assert native[["block", "line", "value"]].tolist() == ev[["block", "line", "value"]].tolist()
+
+
+def test_task_words_in_a_subroutine_and_a_full_turn(linuxcnc_interpreter):
+    """Words inside a subroutine come at each call; a two-turn circle is two blocks."""
+    text = ("o1 sub\nM8\nG91 G1 X1 F60\nG90\nM9\no1 endsub\n"
+            "G0 X0 Y0\nG2 X0 Y0 I1 P2 F60\no1 call\no1 call\nM2")  # fmt: skip
+    tp = parse(text, reader="linuxcnc")
+    assert len(tp) == 5  # rapid, two turns, two lines
+    ev = tp.events
+    assert ev["block"].tolist() == [3, 4, 4, 5] and ev["value"].tolist() == [8.0, 9.0, 8.0, 9.0]
+    assert ev["line"].tolist() == [2, 5, 2, 5]
+
+
 def test_g81_cycle(linuxcnc_interpreter):
     """G98 G81 from Z5 to a hole at X10 Y5, R2, Z-3: over the hole, down to R, feed to the
     bottom, back up to the initial Z; all in exact-path mode."""

@@ -93,8 +93,9 @@ Two readers
 LinuxCNC's own rs274ngc interpreter (``make linuxcnc`` installs it; see
 :mod:`nctwin.gcode._interp`), which reads the whole language and gives the moves LinuxCNC runs,
 as the same :class:`~nctwin.toolpath.Toolpath` (its G5/G5.1 splines as the biarcs LinuxCNC's
-task runs, :mod:`nctwin.gcode._splines`, not the preview's lines; M, S and T words are not
-kept); it takes a LinuxCNC tool table
+task runs, :mod:`nctwin.gcode._splines`, not the preview's lines; of the M, S and T words it
+keeps the M-words LinuxCNC's task waits for, as far as the interpreter's modal state shows them,
+:mod:`nctwin.gcode._task_words`); it takes a LinuxCNC tool table
 (``tool_table=``, default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC
 configuration); a tool the table lacks runs with size 0 unless the program's cutter
 compensation or length offset needs its size (:func:`complete_tool_table`). ``"auto"`` is the

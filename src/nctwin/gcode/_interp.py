@@ -58,8 +58,10 @@ What differs from the native reader (by design)
 * ``blend_tol_mm`` and ``naive_tol_mm`` hold what LinuxCNC uses: a G64 without P gives P = 0
   (native: NaN), and Q defaults to P (native: NaN). :meth:`Toolpath.effective_tolerance_mm` and
   :meth:`Toolpath.effective_naive_tol_mm` are the same for both.
-* ``events`` is empty: the module's spindle, coolant, stop and tool-select calls are empty stubs
-  that never reach Python, so M, S and T words cannot be kept.
+* ``events`` holds the M-words LinuxCNC's task waits for (``M0``, ``M1``, ``M3``-``M9``), read
+  from the interpreter's modal M state (:mod:`nctwin.gcode._task_words`): the module's spindle,
+  coolant, stop and tool-select calls are empty stubs that never reach Python. A word that
+  changes no state (a second ``M8``) is not seen, and S and T words are not kept.
 * Lines of blocks from a subroutine in another file are that file's lines; in such files
   (which are not instrumented) a line's state is the one the next reporting line gives.
 * The tool starts at machine zero (LinuxCNC's preview starts there); ``start_mm`` is refused.
@@ -91,10 +93,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..toolpath import PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
+from ..toolpath import EVENT_DTYPE, PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
 from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
 from ._splines import task_splines
+from ._task_words import M_COLUMNS, task_words
 
 #: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -119,7 +122,7 @@ _MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
 #: The longest line LinuxCNC 2.9's interpreter reads (characters before the newline, measured:
 #: 253 gives "Command too long").
 LINUXCNC_MAX_LINE = 252
-_N_MOVE, _N_MODAL = 7, 13
+_N_MOVE, _N_MODAL, _N_EVENT = 7, 13, 14
 #: LinuxCNC's canon planes (1 XY, 2 YZ, 3 XZ) as :class:`Plane`.
 _PLANE_OF_CANON = np.array([0, Plane.XY, Plane.YZ, Plane.ZX], dtype=np.int8)
 _CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
@@ -380,14 +383,15 @@ def _run_child(job: dict, folder, timeout_s: float, source: str | None) -> bytes
 
 
 def _tables(raw: bytes):
-    """The child's header and its tables: moves (M, 7), events (E, 9: the moves before each, then
-    line, path mode, P, Q, units, feed mode, motion mode, the line's non-modal code) and modal
+    """The child's header and its tables: moves (M, 7), events (E, 14: the moves before each,
+    then line, path mode, P, Q, units, feed mode, motion mode, the line's non-modal code, and
+    the stop, spindle, tool-change, mist and flood M-codes of :mod:`._task_words`) and modal
     records (K, 13)."""
     cut = raw.index(b"\n")
     header = json.loads(raw[:cut])
     sizes = header["bytes"]
     if not sizes:
-        return header, np.zeros((0, _N_MOVE)), np.zeros((0, 9)), np.zeros((0, _N_MODAL))
+        return header, np.zeros((0, _N_MOVE)), np.zeros((0, _N_EVENT)), np.zeros((0, _N_MODAL))
     bounds = np.cumsum([cut + 1, *sizes])
     view = memoryview(raw)  # no copies: the arrays are views of the child's bytes
     part = [view[a:b] for a, b in itertools.pairwise(bounds)]
@@ -407,10 +411,11 @@ def _tables(raw: bytes):
                 g[:, 7],  # feed mode
                 g[:, 1],  # motion mode
                 g[:, 2],  # the line's code of the non-modal group (G4, G28, G92, ...), or -1
+                st["mcodes"][:, M_COLUMNS],
             ]
         )
         if len(st)
-        else np.zeros((0, 9))
+        else np.zeros((0, _N_EVENT))
     )
     modal = np.frombuffer(part[3], np.float64).reshape(-1, _N_MODAL)
     return header, moves, events, modal
@@ -472,7 +477,7 @@ def _reason(message: str, name: str, program: Path, folder) -> str:
 # ---------------------------------------------------------------------------------------------
 def _after_states(events: np.ndarray) -> np.ndarray:
     """The state each event's moves run in: the one the next event reports (see the module
-    docstring), the last event's own for the last one. Shape (E, 8)."""
+    docstring), the last event's own for the last one. Shape (E, 13)."""
     if not len(events):
         return events
     return np.vstack([events[1:], events[-1:]])
@@ -535,6 +540,8 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     if not len(moves):
         return Toolpath.empty()
     moves, events, modal = task_splines(moves, events, modal, source)
+    words = task_words((events[:, 0] / _N_MOVE).astype(np.int64), events[:, 1].astype(np.int64),
+                       events[:, 9:])  # fmt: skip
     kind = moves[:, 0].astype(np.int8)
     index = np.arange(len(moves))
     # the event and modal record of each move: the last one made before it
@@ -616,7 +623,10 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     }
     if (turns > 1).any():
         fields = _expand_turns(fields, turns)
-    return Toolpath(**fields)
+    block = np.concatenate([[0], np.cumsum(turns)])[words[0]]  # a full turn is a block
+    events = np.array(list(zip(block, words[1], "M" * len(block), words[2], strict=True)),
+                      dtype=EVENT_DTYPE)  # fmt: skip
+    return Toolpath(**fields, events=events)
 
 
 def _cycle_exact(kind, ev, after, start, end, plane) -> np.ndarray:

@@ -193,7 +193,7 @@ def task_splines(moves: np.ndarray, events: np.ndarray, modal: np.ndarray, sourc
     ----------
     moves : ndarray, shape (M, 7)
         The preview's moves (inches).
-    events : ndarray, shape (E, 9)
+    events : ndarray, shape (E, 14)
         Events, one a line; column 0 counts the values (7 a move) before each, column 5 holds
         the units (200 G20, 210 G21) of the state after each line.
     modal : ndarray, shape (K, 13)
