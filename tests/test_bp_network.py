@@ -113,3 +113,23 @@ def test_a_diverging_training_raises_a_clear_error() -> None:
                       learning_rate=10.0, loss="mse", optimiser="sgd", momentum=0.8)  # fmt: skip
     with pytest.raises(TrainingDivergedError, match="diverged"):
         fit(config, cfg, xs, ys, cache=False, progress=False)
+
+
+def test_a_diverged_training_stops_at_its_first_nan_weight_and_is_cached(monkeypatch) -> None:
+    from nctwin.learn import train as tr
+
+    xs, ys = _rows()
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.0, weight_init="normal",
+                      weight_std=50.0)  # fmt: skip
+    cfg = TrainConfig(seed=0, max_epochs=5, patience=5, batch_size=1, window_lines=8,
+                      learning_rate=10.0, loss="mse", optimiser="sgd", momentum=0.8)  # fmt: skip
+    steps = []
+    step = tr._autograd_step
+    monkeypatch.setattr(tr, "_autograd_step", lambda *a: steps.append(1) or step(*a))
+    with pytest.raises(tr.TrainingDivergedError, match="diverged") as first:
+        fit(config, cfg, xs, ys, progress=False)
+    assert 0 < len(steps) < 42  # 42 of the 50 chunks train, one a step: stopped in epoch 1
+    monkeypatch.setattr(tr, "_train", lambda *a: pytest.fail("trained again"))
+    with pytest.raises(tr.TrainingDivergedError) as again:  # the divergence is cached
+        fit(config, cfg, xs, ys, progress=False)
+    assert str(again.value) == str(first.value)

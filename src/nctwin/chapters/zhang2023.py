@@ -353,8 +353,9 @@ def batch_sweep(
     Every run stops early after :data:`PAPER_PATIENCE` epochs without improvement. Batch 1
     runs one epoch (12,474 updates, already more than the full batch's 2000); 32 and 256 rows
     run up to :data:`BATCH_SWEEP_EPOCHS`; the full batch up to the paper's 2000 epochs.
-    ``epochs`` and ``updates`` count what ran; ``converged`` says whether early stopping ended
-    the run (False: the cap did, and the run was still learning).
+    ``epochs`` and ``updates`` count what ran (for a diverged run, what was to run: its
+    training stops at the first update that leaves a weight NaN); ``converged`` says whether
+    early stopping ended the run (False: the cap did, and the run was still learning).
 
     Returns
     -------

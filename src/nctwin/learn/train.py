@@ -36,7 +36,10 @@ Checkpoints
     ``AVX512`` on such a CPU outside it: their rounding differs, so a network trained outside
     ``make`` is never reused by a chapter run through it), written atomically (temporary file,
     then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
-    tensors and plain Python values only, never pickled objects.
+    tensors and plain Python values only, never pickled objects. A training that diverges
+    (:class:`TrainingDivergedError`) leaves ``<name>-<hash>.diverged``, its message, so that
+    asking again raises again without training; it stops at the first NaN weight, after which
+    no validation loss can be finite.
 """
 
 from __future__ import annotations
@@ -55,7 +58,7 @@ import torch
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from ..cache import atomic_write, cache_path, content_key
+from ..cache import atomic_write, atomic_write_text, cache_path, content_key
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
@@ -339,6 +342,10 @@ def _autograd_step(model, optimiser, kind: str, x, y, mask) -> torch.Tensor:
     return loss.detach()
 
 
+class _NaNWeights(Exception):
+    """A weight became NaN before any epoch had a finite validation loss (:func:`_train`)."""
+
+
 #: Batches whose windows :meth:`_AutogradRun.epoch` gathers at once (the gather is a fixed cost
 #: per call, as large as a small network's step).
 _BATCHES_PER_GATHER = 64
@@ -358,9 +365,13 @@ class _AutogradRun:
         else:
             self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
 
-    def epoch(self, windows: np.ndarray) -> float:
+    def epoch(self, windows: np.ndarray, *, stop_if_nan: bool = False) -> float:
         """Steps on ``windows`` in batches of ``batch_size``; the mean of the batch losses,
-        weighted by their windows."""
+        weighted by their windows.
+
+        With ``stop_if_nan``, a batch loss that is not finite is followed by a look at the
+        weights: if one is NaN, :class:`_NaNWeights` is raised (see :func:`_train`).
+        """
         self.model.train()
         total, count, cfg = 0.0, 0, self.cfg
         chunk = cfg.batch_size * _BATCHES_PER_GATHER
@@ -368,11 +379,17 @@ class _AutogradRun:
             xs, ys, ms = self.programs.batch(windows[c : c + chunk], cfg.window_lines)
             for b in range(0, len(xs), cfg.batch_size):
                 bx, by, bm = (t[b : b + cfg.batch_size] for t in (xs, ys, ms))
-                loss = _autograd_step(self.model, self.optimiser, cfg.loss, bx, by, bm)
-                total += float(loss) * len(bx)
+                loss = float(_autograd_step(self.model, self.optimiser, cfg.loss, bx, by, bm))
+                if stop_if_nan and not math.isfinite(loss) and self.nan_weights():
+                    raise _NaNWeights
+                total += loss * len(bx)
                 count += len(bx)
         self.model.eval()
         return total / count
+
+    def nan_weights(self) -> bool:
+        """Whether a weight is NaN."""
+        return any(bool(torch.isnan(p).any()) for p in self.model.parameters())
 
     def validate(self) -> float:
         with torch.no_grad():
@@ -437,6 +454,9 @@ def fit(
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
     path = cache_path("models", name, content_key(key), ".pt")
+    diverged = path.with_suffix(".diverged")  # the message of a training that diverged
+    if cache and diverged.exists():
+        raise TrainingDivergedError(diverged.read_text(encoding="utf-8"))
     if cache and path.exists():
         return load_checkpoint(path)
 
@@ -455,6 +475,10 @@ def fit(
             torch.manual_seed(train_config.seed)
             with one_thread(), threadpool_limits(1, user_api="blas"):
                 trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
+    except TrainingDivergedError as error:
+        if cache:
+            atomic_write_text(diverged, str(error))
+        raise
     finally:
         torch.use_deterministic_algorithms(deterministic)
     if cache:
@@ -500,7 +524,14 @@ def _train(
     )
     for epoch in bar:
         windows = _windows(programs.lengths, w, rng)
-        train_loss = run.epoch(windows[rng.permutation(len(windows))])
+        # a NaN weight stays NaN (every update adds to it) and makes every output NaN, so no
+        # later epoch can have a finite validation loss: a run that had none yet has diverged,
+        # and stops there (a run that had one goes on, so that its history is what it was)
+        try:
+            train_loss = run.epoch(windows[rng.permutation(len(windows))],
+                                   stop_if_nan=best_state is None)  # fmt: skip
+        except _NaNWeights:
+            break
         val = run.validate()
         history["train"].append(train_loss)
         history["val"].append(val)
