@@ -480,7 +480,7 @@ def out_of_domain_table(recordings: dict[str, RecordedProgram]) -> pd.DataFrame:
     ----------
     recordings : dict
         :func:`nctwin.recordings.load_recordings`; the group is the name's first word
-        (``train``, ``test``, ``broad``, ``cam``, ``public``).
+        (``train``, ``test``, ``broad``, ``cam``, ``lang``, ``public``, ``sample``).
 
     Returns
     -------
