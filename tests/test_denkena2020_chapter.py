@@ -298,3 +298,22 @@ def test_judged_claims_count_single_seeds_and_keep_the_model_claim_without_seeds
     assert c["reversal_model_fails"].seeds is None
     row = by_seed.set_index("id").loc["lstm_lower_at_least"]
     assert (row.seed_0, row.seed_1) == pytest.approx((80.0, 40.0))
+
+
+def test_chatter_band_splits_the_error_by_parseval() -> None:
+    p = dk.Process(0, "side", "-x", 2.0, 1.0, 300.0, 2600.0, (0, 0, 0), True, 25.0, 0.04, True)
+    t = np.arange(500) / 250.0
+    rec = SimpleNamespace(processes=[p], t_s=t)
+    targets = np.zeros((1, 500, 3))
+    lstm = {0: np.zeros((500, 3))}
+    lstm[0][:, 1] = 10.0 * np.sin(2 * np.pi * 25.0 * t)  # error at the vibration: 10/sqrt 2
+    model = {0: np.full((500, 3), 3.0)}  # a constant error: none of it in the band
+    w = dk.Windows(np.ones((1, 500), dtype=bool), np.ones((1, 500, 3), dtype=bool),
+                   np.zeros((1, 500, 3), dtype=bool))  # fmt: skip
+    out = dk.chatter_band_scores(rec, targets, lstm, model, w).set_index("axis")
+    assert out.loc["Y", "lstm_band_rmse_n"] == pytest.approx(10.0 / np.sqrt(2))
+    assert out.loc["Y", "lstm_rest_rmse_n"] == pytest.approx(0.0, abs=1e-9)
+    assert out.loc["X", "model_rmse_n"] == pytest.approx(3.0)
+    assert out.loc["X", "model_band_rmse_n"] == pytest.approx(0.0, abs=1e-9)
+    with pytest.raises(ValueError, match="band_hz"):
+        dk.chatter_band_scores(rec, targets, lstm, model, w, band_hz=0.0)

@@ -53,6 +53,7 @@ __all__ = [
     "Recorded",
     "Windows",
     "band_coverage",
+    "chatter_band_scores",
     "claims_by_seed",
     "design_processes",
     "figure_cases",
@@ -496,6 +497,60 @@ def reversal_scores(
         rows.append({"window": label, "samples": int(where.sum()),
                      "lstm_rmse_n": _rmse(e["lstm"], 0.0 * e["lstm"], where),
                      "model_rmse_n": _rmse(e["model"], 0.0 * e["model"], where)})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def chatter_band_scores(
+    recorded: Recorded,
+    targets: np.ndarray,
+    lstm: dict[int, np.ndarray],
+    model: dict[int, np.ndarray],
+    windows: Windows,
+    *,
+    band_hz: float = 3.0,
+    axes: str = "XY",
+) -> pd.DataFrame:
+    """Where the error on the semi-stable test cuts lies: each method's RMSE over the cut and
+    the part of it within ``band_hz`` of the cut's vibration frequency (the error's spectrum over
+    the cut, by Parseval: ``band`` squared plus ``rest`` squared is the RMSE squared).
+
+    Parameters
+    ----------
+    recorded : Recorded
+    targets : ndarray, shape (P, R, 3)
+    lstm, model : dict
+        Process index -> forces (R, 3).
+    windows : Windows
+    band_hz : float
+        Half width of the band around ``chatter_hz``, > 0.
+    axes : str
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per semi-stable test process and axis: ``process`` (index), ``axis``,
+        ``chatter_hz``, then per method ``*_rmse_n``, ``*_band_rmse_n`` and ``*_rest_rmse_n``.
+    """
+    if not band_hz > 0.0:
+        raise ValueError(f"band_hz = {band_hz!r} is out of range: allowed > 0")
+    rate_hz = 1.0 / float(recorded.t_s[1] - recorded.t_s[0])
+    rows = []
+    for p in recorded.processes:
+        if not (p.test and p.semi_stable):
+            continue
+        cut = windows.cutting[p.index]
+        freqs = np.fft.rfftfreq(int(cut.sum()), 1.0 / rate_hz)
+        near = np.abs(freqs - p.chatter_hz) <= band_hz
+        for axis in axes:
+            i = "XYZ".index(axis)
+            row = {"process": p.index, "axis": axis, "chatter_hz": p.chatter_hz}
+            for name, pred in (("lstm", lstm[p.index][:, i]), ("model", model[p.index][:, i])):
+                err = pred[cut] - targets[p.index, cut, i]
+                band = np.fft.irfft(np.fft.rfft(err) * near, n=len(err))
+                row[f"{name}_rmse_n"] = _rmse(err, 0.0 * err)
+                row[f"{name}_band_rmse_n"] = _rmse(band, 0.0 * band)
+                row[f"{name}_rest_rmse_n"] = _rmse(err - band, 0.0 * err)
+            rows.append(row)
     return pd.DataFrame(rows)
 
 
