@@ -77,3 +77,27 @@ def test_bad_parameters_name_themselves():
     with pytest.raises(ValueError, match="spindle_rpm"):
         cutting.tool_forces(np.zeros(3), spindle_rpm=0.0, feed_per_tooth_mm=0.1, ap_mm=1.0,
                             phi_start_rad=0.0, phi_exit_rad=1.0, tool=TOOL)  # fmt: skip
+
+
+def test_regenerative_chip_adds_to_the_chip_thickness():
+    # h = (f_z + dx') sin(phi) + dy' cos(phi): a constant dx' is a larger feed per tooth
+    t = np.arange(2000) / 40000.0
+    kw = dict(spindle_rpm=3000.0, ap_mm=2.0, phi_start_rad=0.0, phi_exit_rad=np.pi, tool=TOOL)
+    regen = np.zeros((len(t), 2))
+    regen[:, 0] = 0.01
+    f_regen, tq_regen = cutting.tool_forces(t, feed_per_tooth_mm=0.04, regeneration_mm=regen, **kw)
+    f_feed, tq_feed = cutting.tool_forces(t, feed_per_tooth_mm=0.05, **kw)
+    np.testing.assert_allclose(f_regen, f_feed, atol=1e-9)
+    np.testing.assert_allclose(tq_regen, tq_feed, atol=1e-9)
+    # a vibration normal to the feed at 22 Hz puts a 22 Hz line into the force normal to it
+    t = np.arange(40000) / 40000.0
+    y = 0.03 * np.sin(2 * np.pi * 22.0 * t)
+    period = 60.0 / (4 * 3000.0)
+    regen = np.stack([0 * t, y - 0.03 * np.sin(2 * np.pi * 22.0 * (t - period))], axis=1)
+    lines = []
+    for r in (None, regen):
+        f, _ = cutting.tool_forces(t, feed_per_tooth_mm=0.04, regeneration_mm=r, **kw)
+        lines.append(np.abs(np.fft.rfft(f[:, 1] - f[:, 1].mean()))[22] / len(t))
+    assert lines[0] < 0.1 and lines[1] > 10.0
+    with pytest.raises(ValueError, match="regeneration_mm"):
+        cutting.tool_forces(t, feed_per_tooth_mm=0.04, regeneration_mm=regen[:10], **kw)

@@ -13,7 +13,7 @@ import torch
 from nctwin.chapters import denkena2020 as dk
 from nctwin.chapters import denkena2020_calibration as cal
 from nctwin.chapters import denkena2020_claims as dc
-from nctwin.chapters.denkena2020_bench import _segment
+from nctwin.chapters.denkena2020_bench import _segment, chatter_regeneration_mm
 from nctwin.physics import drives
 from nctwin.report.claims import Claim
 from nctwin.report.papers import load_paper_table
@@ -36,14 +36,39 @@ def test_semi_stability_is_independent_of_the_load() -> None:
     procs = dk.design_processes(GRID, seed=0, duration_s=13.0, semi_stable_share=0.5)
     straight = pd.DataFrame([vars(p) for p in procs if p.kind in ("side", "groove")])
     load = straight.ap_mm * straight.ae_mm
-    semi = straight.semi_stable
-    assert semi.any() and (load[semi] < 12.0).any()  # light cuts can be semi-stable too
+    train = straight[~straight.test]
+    semi = train.semi_stable
+    assert semi.any() and (load[~straight.test][semi] < 12.0).any()  # light cuts too
     assert not any(p.semi_stable for p in procs if p.kind in ("pocket", "ramp"))
     test = straight[straight.test]
-    assert test.semi_stable.any() and (~test.semi_stable).any()
+    # the paper's Fig. 8 case: semi-stable side cuts in -x, several of them, off the grid
+    cases = test[test.semi_stable]
+    assert len(cases) == 4 and (~test.semi_stable).sum() == 10
+    assert set(cases.kind) == {"side"} and set(cases.feed_direction) == {"-x"}
+    assert (cases.ae_mm < 10.0).all() and not cases.vf_mm_min.isin(GRID["vf_mm_min"]).any()
+    lo, hi = dk.CHATTER_RATIO
+    assert cases.chatter_hz.between(lo * dk.MODE_HZ, hi * dk.MODE_HZ).all()
+    assert dk.MODE_HZ == pytest.approx(np.sqrt(947e3 / 60.0) / (2 * np.pi))
     assert sum(p.test for p in procs) == 21
     with pytest.raises(ValueError, match="semi_stable_share"):
         dk.design_processes(GRID, seed=0, duration_s=13.0, semi_stable_share=1.5)
+    with pytest.raises(ValueError, match="semi_stable_test"):
+        dk.design_processes(GRID, seed=0, duration_s=13.0, semi_stable_test=15)
+
+
+def test_chatter_regenerates_the_chip_normal_to_the_feed() -> None:
+    p = dk.Process(0, "side", "-x", 2.0, 1.0, 300.0, 3000.0, (0, 0, 0), True, 25.0, 0.04, True)
+    t = np.array([0.0, 0.01, 0.2])
+    regen = chatter_regeneration_mm(p, t)
+    period = 60.0 / (4 * 3000.0)
+
+    def y(s: float) -> float:
+        return 0.04 * 0.5 * (1 + np.sin(2 * np.pi * 0.7 * s)) * np.sin(2 * np.pi * 25.0 * s)
+
+    np.testing.assert_allclose(regen[:, 1], [y(s) - y(s - period) for s in t], atol=1e-15)
+    assert (regen[:, 0] == 0).all()
+    stable = dk.Process(0, "side", "-x", 2.0, 1.0, 300.0, 3000.0, (0, 0, 0), False, 0, 0, True)
+    assert (chatter_regeneration_mm(stable, t) == 0).all()
 
 
 def test_training_lies_on_the_grid_and_testing_off_it_with_the_paper_ramp() -> None:
@@ -130,9 +155,11 @@ def test_two_sided_band_claims() -> None:
     # LSTM below the model on 2 of 3 rows; ramp 12 against the mean 14
     assert claims["lstm_better_most"].value == pytest.approx(200.0 / 3)
     assert claims["ramp_below_average"].value == pytest.approx(12.0 / 14.0)
-    assert (
-        claims["worst_lstm_semi_stable"].holds and claims["worst_lstm_semi_stable"].whose == "ours"
-    )
+    # semi-stable 20 N against the others' mean of 11 N
+    assert claims["semi_stable_lstm_above"].value == pytest.approx(9.0)
+    assert claims["semi_stable_lstm_above"].holds
+    assert claims["semi_stable_lstm_above"].whose == "paper"
+    assert "semi_stable_y_velocity" in claims["semi_stable_lstm_above"].requires
     assert "ramp_model_rmse_x" in claims["lstm_lower_at_least"].requires
     assert claims["reversal_model_fails"].requires == dc.MODEL_REQUIRES
 
@@ -169,7 +196,9 @@ def test_conditions_read_the_paper_and_measure_ours() -> None:
     recon = {0: np.full((4, 3), 50.6), 1: np.full((4, 3), 20.0)}
     w = dk.Windows(np.ones((2, 4), dtype=bool), np.ones((2, 4, 3), dtype=bool),
                    np.zeros((2, 4, 3), dtype=bool))  # fmt: skip
-    cond = {c.id: c for c in dc.paper_conditions(procs, targets, recon, w, GRID, 250.0, 6.0)}
+    vel = np.zeros((2, 4, 3))
+    cond = {c.id: c for c in dc.paper_conditions(procs, targets, recon, w, GRID, 250.0, 6.0,
+                                                 vel)}  # fmt: skip
     assert cond["ramp_model_rmse_x"].ours == pytest.approx(50.6) and cond["ramp_model_rmse_x"].met
     assert cond["ramp_model_rmse_y"].ours == pytest.approx(50.6)
     assert not cond["ramp_model_rmse_y"].met  # paper 18.2 N
@@ -178,6 +207,26 @@ def test_conditions_read_the_paper_and_measure_ours() -> None:
     assert (cond["test_off_grid"].paper, cond["test_off_grid"].ours) == (100.0, 50.0)
     assert cond["sample_rate"].met and not cond["run_duration"].met
     assert not cond["variations"].met and cond["test_processes"].ours == 2
+    # no semi-stable side cut in -x: too few cases, and no vibration to measure
+    assert cond["semi_stable_cases"].ours == 0 and not cond["semi_stable_cases"].met
+    assert not cond["semi_stable_y_velocity"].met
+
+
+def test_semi_stable_condition_measures_the_y_velocity() -> None:
+    procs = [dk.Process(i, "side", "-x" if i < 3 else "+x", 2.0, 1.0, 300.0, 2600.0, (0, 0, 0),
+                        i < 3, 25.0 * (i < 3), 0.04 * (i < 3), test=i != 3)
+             for i in range(4)]  # fmt: skip
+    vel = np.zeros((4, 4, 3))
+    vel[:3, :, 1] = [1.0, -1.0, 1.0, -1.0]  # std 1 mm/s
+    vel[3, :, 1] = [0.25, -0.25, 0.25, -0.25]  # std 0.25 mm/s
+    w = dk.Windows(np.ones((4, 4), dtype=bool), np.ones((4, 4, 3), dtype=bool),
+                   np.zeros((4, 4, 3), dtype=bool))  # fmt: skip
+    recon = {i: np.zeros((4, 3)) for i in range(3)}
+    cond = {c.id: c for c in dc.paper_conditions(procs, np.zeros((4, 4, 3)), recon, w, GRID,
+                                                 250.0, 13.0, vel)}  # fmt: skip
+    assert cond["semi_stable_cases"].ours == 3 and cond["semi_stable_cases"].met
+    assert cond["semi_stable_y_velocity"].ours == pytest.approx(4.0)
+    assert cond["semi_stable_y_velocity"].met
 
 
 def test_claims_by_seed_reads_every_seed_beside_the_ensemble() -> None:
@@ -249,3 +298,22 @@ def test_judged_claims_count_single_seeds_and_keep_the_model_claim_without_seeds
     assert c["reversal_model_fails"].seeds is None
     row = by_seed.set_index("id").loc["lstm_lower_at_least"]
     assert (row.seed_0, row.seed_1) == pytest.approx((80.0, 40.0))
+
+
+def test_chatter_band_splits_the_error_by_parseval() -> None:
+    p = dk.Process(0, "side", "-x", 2.0, 1.0, 300.0, 2600.0, (0, 0, 0), True, 25.0, 0.04, True)
+    t = np.arange(500) / 250.0
+    rec = SimpleNamespace(processes=[p], t_s=t)
+    targets = np.zeros((1, 500, 3))
+    lstm = {0: np.zeros((500, 3))}
+    lstm[0][:, 1] = 10.0 * np.sin(2 * np.pi * 25.0 * t)  # error at the vibration: 10/sqrt 2
+    model = {0: np.full((500, 3), 3.0)}  # a constant error: none of it in the band
+    w = dk.Windows(np.ones((1, 500), dtype=bool), np.ones((1, 500, 3), dtype=bool),
+                   np.zeros((1, 500, 3), dtype=bool))  # fmt: skip
+    out = dk.chatter_band_scores(rec, targets, lstm, model, w).set_index("axis")
+    assert out.loc["Y", "lstm_band_rmse_n"] == pytest.approx(10.0 / np.sqrt(2))
+    assert out.loc["Y", "lstm_rest_rmse_n"] == pytest.approx(0.0, abs=1e-9)
+    assert out.loc["X", "model_rmse_n"] == pytest.approx(3.0)
+    assert out.loc["X", "model_band_rmse_n"] == pytest.approx(0.0, abs=1e-9)
+    with pytest.raises(ValueError, match="band_hz"):
+        dk.chatter_band_scores(rec, targets, lstm, model, w, band_hz=0.0)

@@ -6,8 +6,10 @@ The chapter's pipeline, kept out of the notebook:
 1. :func:`design_processes` draws 160 training processes over the Table 1 grid and 21 test
    processes off it, the paper's ramp row among them (side and groove milling in eight feed
    directions, counter-clockwise circular pockets with a plunge, -y/+z ramps), and marks a
-   seeded share of the straight cuts semi-stable. The bench's compliance was fixed before, from
-   the model's errors alone (:mod:`nctwin.chapters.denkena2020_calibration`).
+   seeded share of the straight training cuts and four side cuts in -x of the test set
+   semi-stable (the tool vibrates normal to the feed near the tool-slide mode). The bench's
+   compliance was fixed before, from the model's errors alone
+   (:mod:`nctwin.chapters.denkena2020_calibration`).
 2. :func:`run_processes` (:mod:`nctwin.chapters.denkena2020_bench`, the simulated test bench)
    interpolates each process, computes its milling forces and runs the drives.
 3. :func:`fit_force_model` fits the paper's model (:mod:`nctwin.methods.denkena2020`) on the air
@@ -51,6 +53,7 @@ __all__ = [
     "Recorded",
     "Windows",
     "band_coverage",
+    "chatter_band_scores",
     "claims_by_seed",
     "design_processes",
     "figure_cases",
@@ -90,11 +93,15 @@ def _start(rng: np.random.Generator, direction: str, vf_mm_min: float, duration_
     return (float(x), float(y), z)
 
 
-def _draw(rng: np.random.Generator, grid: dict, kind: str, off_grid: bool, groove_share: float):
-    """Kind, feed direction, ae, ap, f, n of a new process: on the grid or off it."""
+def _draw(rng: np.random.Generator, grid: dict, kind: str, off_grid: bool, groove_share: float,
+          side_minus_x: bool = False):  # fmt: skip
+    """Kind, feed direction, ae, ap, f, n of a new process: on the grid or off it
+    (``side_minus_x``: a side cut in -x, ae below D, off the grid)."""
     if off_grid:
-        groove = kind == "straight" and rng.random() < groove_share
+        groove = kind == "straight" and not side_minus_x and rng.random() < groove_share
         ae = TOOL.diameter_mm if groove else _off_grid_value(rng, grid["ae_mm"], 0.5)
+        while side_minus_x and ae >= TOOL.diameter_mm:
+            ae = _off_grid_value(rng, grid["ae_mm"], 0.5)
         ap = _off_grid_value(rng, grid["ap_mm"], 0.5)
         vf = _off_grid_value(rng, grid["vf_mm_min"], 50.0)
         n = _off_grid_value(rng, grid["n_rpm"], 100.0)
@@ -103,11 +110,21 @@ def _draw(rng: np.random.Generator, grid: dict, kind: str, off_grid: bool, groov
             float(rng.choice(grid[c])) for c in ("ae_mm", "ap_mm", "vf_mm_min", "n_rpm")
         )
     if kind == "straight":
-        return ("groove" if ae >= TOOL.diameter_mm else "side", str(rng.choice(list(DIRECTIONS))),
-                ae, ap, vf, n)  # fmt: skip
+        direction = "-x" if side_minus_x else str(rng.choice(list(DIRECTIONS)))
+        return ("groove" if ae >= TOOL.diameter_mm else "side", direction, ae, ap, vf, n)
     return (
         ("pocket", "ccw", ae, ap, vf, n) if kind == "pocket" else ("ramp", "-y/+z", ae, ap, vf, n)
     )
+
+
+#: Frequency of the tool-slide mode of the bench (Hz), :math:`\sqrt{k_c / m_c} / 2\pi`.
+MODE_HZ = float(np.sqrt(drives.COMPLIANCE_STIFFNESS_N_MM * 1e3 / drives.COMPLIANCE_MASS_KG)
+                / (2.0 * np.pi))  # fmt: skip
+#: A semi-stable cut vibrates at this multiple of :data:`MODE_HZ` (regenerative chatter sets in
+#: just above the natural frequency of the mode that limits stability).
+CHATTER_RATIO = (1.0, 1.3)
+#: Amplitude of that vibration normal to the feed (mm), drawn in this range.
+CHATTER_AMPLITUDE_MM = (0.03, 0.06)
 
 
 def design_processes(
@@ -119,6 +136,7 @@ def design_processes(
     counts: tuple[int, int, int] = (121, 36, 24),
     test_counts: tuple[int, int, int] = (14, 4, 3),
     semi_stable_share: float = 0.1,
+    semi_stable_test: int = 4,
 ) -> list[Process]:
     """The experiment: training processes on the Table 1 grid, test processes off it.
 
@@ -139,11 +157,17 @@ def design_processes(
         How many of each are test processes (default 21): the paper's, then new ones whose every
         parameter is drawn within the Table 1 range off its values (ap and ae on a 0.5 mm raster,
         f on 50 mm/min, n on 100 1/min; a straight test cut is a groove with the share of
-        grooves on the grid). Semi-stable test cuts: the share of ``semi_stable_share`` of the
-        straight ones, at least one.
+        grooves on the grid).
     semi_stable_share : float
-        Probability that a side or groove cut is semi-stable, in [0, 1], drawn independently of
-        its parameters (so semi-stability is not confounded with the size of the force).
+        Probability that a training side or groove cut is semi-stable, in [0, 1], drawn
+        independently of its parameters (so semi-stability is not confounded with the size of
+        the force).
+    semi_stable_test : int
+        How many of the straight test processes are semi-stable side cuts in -x (the paper's
+        Fig. 8), off the grid like the others; the rest of them are stable. Semi-stable: the
+        tool vibrates normal to the feed at :data:`CHATTER_RATIO` times the tool-slide mode,
+        with an amplitude in :data:`CHATTER_AMPLITUDE_MM`
+        (:func:`~nctwin.chapters.denkena2020_bench.chatter_regeneration_mm`).
 
     Returns
     -------
@@ -162,6 +186,9 @@ def design_processes(
         raise ValueError(
             f"counts = {counts!r}, test_counts = {test_counts!r}: allowed 1 <= test < count"
         )
+    if not 0 <= semi_stable_test <= test_counts[0]:
+        raise ValueError(f"semi_stable_test = {semi_stable_test!r} is out of range: allowed 0 to "
+                         f"{test_counts[0]}")  # fmt: skip
     kinds = ("straight", "pocket", "ramp")
     group = {"side": "straight", "groove": "straight", "pocket": "pocket", "ramp": "ramp"}
     given = {k: [q for q in paper_test if group[q["kind"]] == k] for k in kinds}
@@ -169,6 +196,7 @@ def design_processes(
         raise ValueError(f"paper_test has more processes of a kind than test_counts = "
                          f"{test_counts!r}")  # fmt: skip
     rng = np.random.default_rng([seed, 7])
+    semi_rng = np.random.default_rng([seed, 8])  # the semi-stable test cuts: their own stream
     groove_share = grid["ae_mm"].count(TOOL.diameter_mm) / len(grid["ae_mm"])
     seen: set = set()
     rows = []
@@ -176,25 +204,29 @@ def design_processes(
         for kind, count, n_test in zip(kinds, counts, test_counts, strict=True):
             made = 0
             todo = list(given[kind]) if test else []
-            n_semi = max(1, round(n_test * semi_stable_share)) if test and kind == "straight" else 0
+            n_semi = semi_stable_test if test and kind == "straight" else 0
             while made < (n_test if test else count - n_test):
+                semi_test = test and made >= n_test - n_semi
+                r = semi_rng if semi_test else rng
                 if todo:
                     q = todo.pop(0)
                     k, direction = q["kind"], q["feed_direction"]
                     ae, ap, vf, n = (float(q[c]) for c in ("ae_mm", "ap_mm", "vf_mm_min", "n_rpm"))
                 else:
-                    k, direction, ae, ap, vf, n = _draw(rng, grid, kind, test, groove_share)
+                    k, direction, ae, ap, vf, n = _draw(r, grid, kind, test, groove_share,
+                                                        side_minus_x=semi_test)  # fmt: skip
                 key = (k, direction, ae, ap, vf, n)
                 if key in seen:
                     continue
                 seen.add(key)
                 if test:
-                    semi = k in ("side", "groove") and made >= n_test - n_semi
+                    semi = semi_test
                 else:
                     semi = bool(k in ("side", "groove") and rng.random() < semi_stable_share)
-                rows.append([k, direction, ae, ap, vf, n, _start(rng, direction, vf, duration_s),
-                             bool(semi), float(rng.uniform(45.0, 95.0)) if semi else 0.0,
-                             float(rng.uniform(0.5, 0.9)) if semi else 0.0, test])  # fmt: skip
+                rows.append([k, direction, ae, ap, vf, n, _start(r, direction, vf, duration_s),
+                             semi, MODE_HZ * float(r.uniform(*CHATTER_RATIO)) if semi else 0.0,
+                             float(r.uniform(*CHATTER_AMPLITUDE_MM)) if semi else 0.0,
+                             test])  # fmt: skip
                 made += 1
     return [Process(i, *r[:-1], test=r[-1]) for i, r in enumerate(rows)]
 
@@ -465,6 +497,60 @@ def reversal_scores(
         rows.append({"window": label, "samples": int(where.sum()),
                      "lstm_rmse_n": _rmse(e["lstm"], 0.0 * e["lstm"], where),
                      "model_rmse_n": _rmse(e["model"], 0.0 * e["model"], where)})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def chatter_band_scores(
+    recorded: Recorded,
+    targets: np.ndarray,
+    lstm: dict[int, np.ndarray],
+    model: dict[int, np.ndarray],
+    windows: Windows,
+    *,
+    band_hz: float = 3.0,
+    axes: str = "XY",
+) -> pd.DataFrame:
+    """Where the error on the semi-stable test cuts lies: each method's RMSE over the cut and
+    the part of it within ``band_hz`` of the cut's vibration frequency (the error's spectrum over
+    the cut, by Parseval: ``band`` squared plus ``rest`` squared is the RMSE squared).
+
+    Parameters
+    ----------
+    recorded : Recorded
+    targets : ndarray, shape (P, R, 3)
+    lstm, model : dict
+        Process index -> forces (R, 3).
+    windows : Windows
+    band_hz : float
+        Half width of the band around ``chatter_hz``, > 0.
+    axes : str
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per semi-stable test process and axis: ``process`` (index), ``axis``,
+        ``chatter_hz``, then per method ``*_rmse_n``, ``*_band_rmse_n`` and ``*_rest_rmse_n``.
+    """
+    if not band_hz > 0.0:
+        raise ValueError(f"band_hz = {band_hz!r} is out of range: allowed > 0")
+    rate_hz = 1.0 / float(recorded.t_s[1] - recorded.t_s[0])
+    rows = []
+    for p in recorded.processes:
+        if not (p.test and p.semi_stable):
+            continue
+        cut = windows.cutting[p.index]
+        freqs = np.fft.rfftfreq(int(cut.sum()), 1.0 / rate_hz)
+        near = np.abs(freqs - p.chatter_hz) <= band_hz
+        for axis in axes:
+            i = "XYZ".index(axis)
+            row = {"process": p.index, "axis": axis, "chatter_hz": p.chatter_hz}
+            for name, pred in (("lstm", lstm[p.index][:, i]), ("model", model[p.index][:, i])):
+                err = pred[cut] - targets[p.index, cut, i]
+                band = np.fft.irfft(np.fft.rfft(err) * near, n=len(err))
+                row[f"{name}_rmse_n"] = _rmse(err, 0.0 * err)
+                row[f"{name}_band_rmse_n"] = _rmse(band, 0.0 * band)
+                row[f"{name}_rest_rmse_n"] = _rmse(err - band, 0.0 * err)
+            rows.append(row)
     return pd.DataFrame(rows)
 
 

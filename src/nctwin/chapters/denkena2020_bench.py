@@ -26,6 +26,7 @@ __all__ = [
     "Process",
     "Recorded",
     "Windows",
+    "chatter_regeneration_mm",
     "process_windows",
     "run_air_moves",
     "run_processes",
@@ -64,9 +65,10 @@ class Process:
     start_mm : tuple of float
         Tool centre at the start.
     semi_stable : bool
-        Chatter-like chip-thickness modulation while cutting.
-    chatter_hz, chatter_depth : float
-        Its frequency and relative amplitude (0 when stable).
+        The tool vibrates against the workpiece normal to the feed while cutting
+        (:func:`chatter_regeneration_mm`).
+    chatter_hz, chatter_amplitude_mm : float
+        Frequency and amplitude of that vibration (0 when stable).
     test : bool
         In the 21-process test set.
     """
@@ -81,7 +83,7 @@ class Process:
     start_mm: tuple[float, float, float]
     semi_stable: bool
     chatter_hz: float
-    chatter_depth: float
+    chatter_amplitude_mm: float
     test: bool
 
 
@@ -154,6 +156,43 @@ def _trajectory(p: Process, n_steps: int, dt: float):
     return tuple(_hold(n_steps, a) for a in parts)
 
 
+def chatter_regeneration_mm(p: Process, t_s: np.ndarray) -> np.ndarray:
+    """The regenerative chip of a semi-stable cut (:func:`nctwin.physics.cutting.tool_forces`).
+
+    The tool vibrates against the workpiece normal to the feed (:math:`y'`) in a bounded limit
+    cycle near the tool-slide mode, beating slowly as a semi-stable process does,
+
+    .. math:: y'(t) = A \\, \\tfrac12 \\left(1 + \\sin(2\\pi \\cdot 0.7\\,t + i)\\right)
+              \\sin(2\\pi f_c t),
+
+    and each tooth cuts the surface the previous tooth left one tooth period :math:`T = 60 /
+    (N n)` earlier: :math:`\\Delta y' = y'(t) - y'(t - T)`. The force this adds at :math:`f_c`
+    reaches the slides through their compliance (:mod:`nctwin.physics.drives`), near its
+    resonance, so the vibration shows in the velocity and current of the axis normal to the feed.
+
+    Parameters
+    ----------
+    p : Process
+        ``chatter_hz`` :math:`f_c`, ``chatter_amplitude_mm`` :math:`A`, ``index`` :math:`i`.
+    t_s : ndarray, shape (T,)
+
+    Returns
+    -------
+    ndarray, shape (T, 2)
+        :math:`(\\Delta x', \\Delta y')`; zeros when the cut is stable.
+    """
+    out = np.zeros((len(t_s), 2))
+    if p.semi_stable:
+        period = 60.0 / (TOOL.teeth * p.n_rpm)
+
+        def y(t):
+            env = 0.5 * (1 + np.sin(2 * np.pi * 0.7 * t + p.index))
+            return p.chatter_amplitude_mm * env * np.sin(2 * np.pi * p.chatter_hz * t)
+
+        out[:, 1] = y(t_s) - y(t_s - period)
+    return out
+
+
 def _process_signals(p: Process, n_steps: int, dt: float):
     """Set points (pos, vel, acc), force on the workpiece (n, 3), torque (n,), rpm (n,)."""
     pos, angle, weight, depth, flag = _trajectory(p, n_steps, dt)
@@ -162,11 +201,7 @@ def _process_signals(p: Process, n_steps: int, dt: float):
     t = np.arange(n_steps) * dt
     tooth_hz = TOOL.teeth * p.n_rpm / 60.0
     fz = np.linalg.norm(vel[:, :2], axis=1) / tooth_hz
-    if p.semi_stable:
-        env = 0.5 * (1 + np.sin(2 * np.pi * 0.7 * t + p.index))
-        mod = p.chatter_depth * env * np.sin(2 * np.pi * p.chatter_hz * t)
-    else:
-        mod = 0.0
+    regen = chatter_regeneration_mm(p, t)
     force = np.zeros((n_steps, 3))
     torque = np.zeros(n_steps)
     for code, ae in ((1, TOOL.diameter_mm), (2, p.ae_mm)):
@@ -183,7 +218,7 @@ def _process_signals(p: Process, n_steps: int, dt: float):
             phi_start_rad=st,
             phi_exit_rad=ex,
             tool=TOOL,
-            modulation=np.broadcast_to(mod, t.shape)[on],
+            regeneration_mm=regen[on],
         )
         force[on] = cutting.workpiece_forces(f * weight[on, None], angle[on])
         torque[on] = tq * weight[on]
@@ -341,7 +376,7 @@ def run_processes(
         "duration_s": duration_s,
         "seed": seed,
         "batch_size": batch_size,
-        "version": 3,
+        "version": 4,
     }
     path = cache_path("denkena2020", "processes", content_key(key), ".npz")
     if path.exists():

@@ -22,6 +22,9 @@ __all__ = [
     "MOST_PCT",
     "REDUCTION_BAND_PCT",
     "RMSE_TOL_PCT",
+    "SEMI_STABLE_MIN_CASES",
+    "SEMI_STABLE_MIN_VELOCITY_RATIO",
+    "SEMI_STABLE_REQUIRES",
     "claims",
     "judged_claims",
     "paper_conditions",
@@ -49,6 +52,14 @@ LEARNED_REQUIRES = (
     "ramp_model_rmse_y",
     "test_off_grid",
 )
+#: Conditions of the claim on the semi-stable cuts, besides :data:`LEARNED_REQUIRES`.
+SEMI_STABLE_REQUIRES = ("semi_stable_cases", "semi_stable_y_velocity")
+#: "Several" semi-stable side cuts in -x in the test set (Fig. 8 and "other semi-stable
+#: processes", Sec. 3.2): at least this many.
+SEMI_STABLE_MIN_CASES = 3
+#: Their vibration shows in the Y-axis velocity (Sec. 3.2): the standard deviation of the recorded
+#: Y velocity over their cuts at least this multiple of that over the stable cuts along +/-x.
+SEMI_STABLE_MIN_VELOCITY_RATIO = 2.0
 #: Conditions the paper's claim on the model alone is tested under.
 MODEL_REQUIRES = ("sample_rate", "groove_model_rmse")
 _PAPER = "Denkena et al. 2020"
@@ -75,6 +86,7 @@ def paper_conditions(
     grid: dict[str, list[float]],
     record_rate_hz: float,
     duration_s: float,
+    velocity_mm_s: np.ndarray,
 ) -> list[Condition]:
     """The paper's experiment beside ours, its values read from ``data/papers/``.
 
@@ -85,6 +97,12 @@ def paper_conditions(
       grooves (both axes moving; Figs. 4-5) within the same tolerance of the paper's range.
     * The test set: the paper's "comprises new process parameters" (abstract); its surviving
       Table 2 rows lie off the Table 1 grid. Met when at least half of our test processes do.
+    * The semi-stable cases (Fig. 8, Sec. 3.2: a side milling in -x whose Y-axis velocity
+      oscillates, and "other semi-stable processes"): at least :data:`SEMI_STABLE_MIN_CASES`
+      semi-stable side cuts in -x in the test set, and their vibration visible in the recorded
+      Y velocity: its standard deviation over their cuts at least
+      :data:`SEMI_STABLE_MIN_VELOCITY_RATIO` times that over the stable straight cuts along
+      +/-x (training and test), where Y stands still too.
 
     Parameters
     ----------
@@ -98,6 +116,8 @@ def paper_conditions(
         Table 1: parameter -> values.
     record_rate_hz, duration_s : float
         Ours.
+    velocity_mm_s : ndarray, shape (P, R, 3)
+        Recorded axis velocities of every process.
 
     Returns
     -------
@@ -146,6 +166,25 @@ def paper_conditions(
         Condition("test_off_grid", f"{_PAPER}, abstract and Table 2: test processes whose "
                   "parameters lie off the Table 1 grid (at least half)", paper_off, ours_off, "%",
                   low=50.0),
+    ]  # fmt: skip
+    semi = [p.index for p in test if p.semi_stable and p.kind == "side"
+            and p.feed_direction == "-x"]  # fmt: skip
+    calm = [p.index for p in processes if not p.semi_stable and p.kind in ("side", "groove")
+            and p.feed_direction in ("+x", "-x")]  # fmt: skip
+
+    def y_std(indices: list[int]) -> float:
+        return float(np.mean([velocity_mm_s[i, windows.cutting[i], 1].std() for i in indices]))
+
+    conditions += [
+        Condition("semi_stable_cases", f"{_PAPER}, Sec. 3.2 (Fig. 8 and other semi-stable "
+                  "processes): semi-stable side milling in -x among the test processes (at "
+                  f"least {SEMI_STABLE_MIN_CASES})", float("nan"), len(semi), "processes",
+                  low=SEMI_STABLE_MIN_CASES),
+        Condition("semi_stable_y_velocity", f"{_PAPER}, Sec. 3.2 (oscillating Y-axis velocity): "
+                  "std of the recorded Y velocity over the cut, semi-stable -x side cuts over "
+                  f"stable cuts along +/-x (at least {SEMI_STABLE_MIN_VELOCITY_RATIO:g})",
+                  float("nan"), y_std(semi) / y_std(calm) if semi and calm else float("nan"),
+                  "1", low=SEMI_STABLE_MIN_VELOCITY_RATIO),
     ]  # fmt: skip
     return conditions
 
@@ -231,9 +270,9 @@ def claims(
     the paper's ``lstm_rmse_lower_than_model``); in most cases (more than :data:`MOST_PCT` of the
     test rows) the LSTM's RMSE below the model's; on circular pockets the model's mean RMSE above
     the LSTM's; the ramp's LSTM RMSE below the average; in the reversal windows the model's RMSE
-    above its RMSE on the rest of the cut, and above the LSTM's there. Ours: the worst LSTM case
-    relative to its force is one of our semi-stable cuts (a chip-thickness modulation, not the
-    paper's Fig. 8 case).
+    above its RMSE on the rest of the cut, and above the LSTM's there; on the semi-stable side
+    cuts in -x (Fig. 8) the LSTM's mean RMSE, in newtons, above its mean over the other test
+    rows.
 
     Parameters
     ----------
@@ -255,7 +294,7 @@ def claims(
     q = paper_summary.set_index("quantity")["value"].astype(float)
     pockets = table[table["process"] == "circular pocket"]
     ramps = table[table["process"] == "ramp milling"]
-    worst = table.loc[table["lstm_cutting_nrmse"].idxmax()]
+    semi = table["semi_stable"].astype(bool)
     lower = summary["lstm_lower_pct"].iloc[0]
     better = 100.0 * np.mean(table["lstm_cutting_rmse_n"] < table["model_cutting_rmse_n"])
     rev = reversal.set_index("window")
@@ -287,9 +326,13 @@ def claims(
               rev.loc["reversal windows", "model_rmse_n"]
               - rev.loc["reversal windows", "lstm_rmse_n"],
               ">", 0.0, **learned),
-        Claim("worst_lstm_semi_stable", "Of our test cuts, the worst LSTM case relative to its "
-              "force (RMSE over the cut / max |F|) is one with the imposed chip-thickness "
-              "modulation (1 = yes)", float(worst["semi_stable"]), "==", 1.0, whose="ours"),
+        Claim("semi_stable_lstm_above", "On the semi-stable side cuts in -x the LSTM's mean "
+              "RMSE over the cut exceeds its mean over the other test rows (N, semi-stable minus "
+              f"the others; paper: such outliers lever the mean to {q['lstm_rmse_mean']:g} N "
+              f"against a median of {q['lstm_rmse_median']:g} N, {_PAPER}, Sec. 3.2, Fig. 8)",
+              table.loc[semi, "lstm_cutting_rmse_n"].mean()
+              - table.loc[~semi, "lstm_cutting_rmse_n"].mean(), ">", 0.0,
+              requires=LEARNED_REQUIRES + SEMI_STABLE_REQUIRES),
     ]  # fmt: skip
 
 

@@ -12,7 +12,11 @@ Frames
     the force *on the workpiece*, which is also the load the feed drives carry.
 Cutting law
     Per tooth :math:`j` and axial disc :math:`k` of height :math:`dz`, with chip thickness
-    :math:`h = f_z \sin\phi + \Delta r_j` (runout :math:`\Delta r_j`),
+    :math:`h = f_z \sin\phi + \Delta r_j + \Delta x' \sin\phi + \Delta y' \cos\phi`
+    (runout :math:`\Delta r_j`; regenerative dynamic chip of a tool vibrating against the
+    workpiece by :math:`(x', y')(t)`, :math:`\Delta x' = x'(t) - x'(t - T)` and likewise
+    :math:`\Delta y'`, :math:`T` the tooth period; Altintas 2012, ch. 3; a tooth that leaves
+    the cut, :math:`h \le 0`, cuts nothing, which bounds a chatter vibration),
 
     .. math:: dF_t = (K_{tc} h + K_{te})\,dz, \quad dF_r = (K_{rc} h + K_{re})\,dz, \quad
               dF_a = (K_{ac} h + K_{ae})\,dz,
@@ -151,7 +155,7 @@ def tool_forces(
     phi_exit_rad: float,
     tool: EndMill,
     coefficients: CuttingCoefficients = C45,
-    modulation: np.ndarray | float = 0.0,
+    regeneration_mm: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Forces on the tool in the feed frame, and the cutting torque.
 
@@ -169,9 +173,9 @@ def tool_forces(
         Engagement (:func:`immersion`).
     tool : EndMill
     coefficients : CuttingCoefficients
-    modulation : float or ndarray, shape (T,)
-        Relative chip-thickness modulation (a chatter-like vibration of the tool against the
-        workpiece): :math:`h \\to h (1 + m(t))`, > -1.
+    regeneration_mm : ndarray, shape (T, 2), optional
+        :math:`(\\Delta x', \\Delta y')`: the tool's vibration against the workpiece now minus
+        one tooth period ago, in the feed frame (the regenerative chip); None: no vibration.
 
     Returns
     -------
@@ -190,7 +194,9 @@ def tool_forces(
     n_t = t.shape[0]
     fz = np.broadcast_to(np.asarray(feed_per_tooth_mm, dtype=float), (n_t,))
     ap = np.broadcast_to(np.asarray(ap_mm, dtype=float), (n_t,))
-    mod = np.broadcast_to(np.asarray(modulation, dtype=float), (n_t,))
+    regen = np.zeros((n_t, 2)) if regeneration_mm is None else np.asarray(regeneration_mm)
+    if regen.shape != (n_t, 2):
+        raise ValueError(f"regeneration_mm shape = {regen.shape!r}: allowed ({n_t}, 2)")
     r = tool.radius_mm
     n_teeth = tool.teeth
     pitch = 2.0 * np.pi / n_teeth
@@ -207,7 +213,11 @@ def tool_forces(
         (phi >= phi_start_rad) & (phi <= phi_exit_rad) & (z[None, None, :] < ap[:, None, None])
     )
     sin_p, cos_p = np.sin(phi), np.cos(phi)
-    h = (fz[:, None, None] * sin_p + d_r[None, :, None]) * (1.0 + mod[:, None, None])
+    h = (
+        (fz[:, None, None] + regen[:, 0, None, None]) * sin_p
+        + regen[:, 1, None, None] * cos_p
+        + d_r[None, :, None]
+    )
     cut = engaged & (h > 0.0) & (fz[:, None, None] > 0.0)
     h = np.where(cut, h, 0.0)
     # the last disc is partial where ap is not a multiple of disc_mm
