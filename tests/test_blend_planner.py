@@ -8,19 +8,17 @@ import numpy as np
 import pytest
 
 from nctwin.estimate import estimate
-from nctwin.estimate.blend_junctions import parabolic_directions
-from nctwin.estimate.blend_planner import (
-    KINK_RATIO,
+from nctwin.estimate.blend_junctions import KINK_RATIO, blend_plane_acc, parabolic_directions
+from nctwin.estimate.blend_limits import (
     MIN_SEGMENT_CYCLES,
     NORMAL_ACC_RATIO,
     STOP_TURN_RAD,
-    blend_plane_acc,
-    blend_planner,
     junction_blends,
     move_limits,
     parabolic_junctions,
     tangent_junctions,
 )
+from nctwin.estimate.blend_planner import blend_planner
 from nctwin.estimate.blend_speeds import OPTIMIZATION_DEPTH, optimised_end_speeds, stops_on_periods
 from nctwin.gcode import parse
 from nctwin.machine import load_profile

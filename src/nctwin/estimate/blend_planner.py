@@ -66,18 +66,14 @@ from .blend_junctions import (
     PARABOLIC_BLEND,
     TANGENT_BLEND,
     arc_junctions,
-    blend_plane_acc,
     parabolic_directions,
 )
 from .blend_limits import (
     MIN_SEGMENT_CYCLES,
-    NORMAL_ACC_RATIO,
     STOP_TURN_RAD,
     TANGENTIAL_ACC_RATIO,
-    TOLERANCE_RATIO,
     MoveLimits,
     junction_blends,
-    move_limits,
     parabolic_blend_speeds,
     parabolic_junctions,
     tangent_junctions,
@@ -86,21 +82,7 @@ from .blend_speeds import optimised_end_speeds, segment_times, stops_on_periods
 from .result import Estimate
 from .task_waits import task_stops
 
-__all__ = [
-    "KINK_RATIO",
-    "MIN_SEGMENT_CYCLES",
-    "NORMAL_ACC_RATIO",
-    "STOP_PERIODS",
-    "STOP_TURN_RAD",
-    "TANGENTIAL_ACC_RATIO",
-    "TOLERANCE_RATIO",
-    "blend_plane_acc",
-    "blend_planner",
-    "junction_blends",
-    "move_limits",
-    "parabolic_junctions",
-    "tangent_junctions",
-]
+__all__ = ["STOP_PERIODS", "blend_planner"]
 
 #: What a stop costs beyond its trapezoids (:func:`blend_planner`'s ``stop_periods``).
 STOP_PERIODS = ("whole", "mean", "off")

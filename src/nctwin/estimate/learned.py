@@ -46,7 +46,7 @@ from ..recordings import NAME as RECORDINGS
 from ..recordings import RecordedProgram, load_recordings
 from ..targets import BlockTargets
 from ..toolpath import MotionKind, Toolpath
-from .blend_planner import move_limits
+from .blend_limits import move_limits
 from .result import Estimate
 
 __all__ = [
@@ -379,7 +379,7 @@ def trained_models(profile: Profile, seed: int = 0) -> tuple[Trained, list[Train
 def move_floors_s(data: MoveData) -> np.ndarray:
     """Physical floor of each move, its length over its feed within the machine's limits
     (:func:`features`: the programmed feed, the rapid feed for rapids, clipped to the maximum
-    feed and to the axis velocities along the move, :func:`~nctwin.estimate.blend_planner.
+    feed and to the axis velocities along the move, :func:`~nctwin.estimate.blend_limits.
     move_limits`), shape (M,): no control runs a move faster."""
     return data.features[:, 1] / data.features[:, 0]
 
