@@ -28,15 +28,17 @@ def _rows(spec: bp.PaperPocket) -> tuple[np.ndarray, np.ndarray]:
     return zigzag[rows], zigzag[rows + 1]
 
 
-def test_rows_on_the_bottom_wall_by_hand():
+@pytest.mark.parametrize("step", [STEP, 2 * R])  # Table 2's stepover and Table 3's (2R)
+def test_rows_on_the_bottom_wall_by_hand(step):
     # bottom wall y = 0 from x = 0 to 230: the outline's ring runs at y = R, the island's at
     # y = band - R, between the island's sharp corners x = band and 230 - band
     band = 25.0
-    spec = bp.PaperPocket(outline_scale=1.0, band_mm=band, chord_tol_mm=1e-3)
+    spec = bp.PaperPocket(outline_scale=1.0, band_mm=band, chord_tol_mm=1e-3, stepover_mm=step)
     start, end = _rows(spec)
     assert np.allclose(start[0], [115.0, band - R])  # the middle of the island's bottom wall
     wall = (start[:, 0] > band + 1) & (start[:, 0] < 230 - band - 1) & (start[:, 1] < band)
-    assert wall.sum() > 60  # 180 mm of wall, rows < 2 mm apart
+    assert wall.sum() >= 178 / step  # 178 mm of wall, rows at most a stepover apart
+    assert np.diff(np.sort(start[wall, 0])).max() <= step + 1e-9
     assert np.allclose(start[wall, 0], end[wall, 0])  # along the wall's normal
     assert np.allclose(np.sort([start[wall, 1], end[wall, 1]], axis=0), [[R], [band - R]])
     assert np.allclose(np.linalg.norm(end[wall] - start[wall], axis=1), band - 2 * R)
@@ -44,15 +46,20 @@ def test_rows_on_the_bottom_wall_by_hand():
     assert np.allclose(end[0, 1], R) and np.allclose(start[1, 1], R)
 
 
-def test_rows_are_spaced_by_at_most_the_stepover_on_both_rings():
-    spec = bp.PaperPocket(outline_scale=1.0, band_mm=25.0, chord_tol_mm=1e-3)
+@pytest.mark.parametrize("step", [STEP, 2 * R])
+def test_rows_are_spaced_by_at_most_the_stepover_on_both_rings(step):
+    spec = bp.PaperPocket(outline_scale=1.0, band_mm=25.0, chord_tol_mm=1e-3, stepover_mm=step)
     start, end = _rows(spec)
     feet = np.where((np.arange(len(start)) % 2 == 0)[:, None], start, end)  # island side
     tips = np.where((np.arange(len(start)) % 2 == 0)[:, None], end, start)
     gaps = [np.linalg.norm(np.diff(side, axis=0), axis=1) for side in (feet, tips)]
-    assert max(g.max() for g in gaps) <= STEP + 1e-9
-    assert np.maximum(*gaps).min() > 0.75 * STEP  # no crowding on both rings at once
-    # the rows in the outline's sharp bottom-right corner run longer than the band
+    assert max(g.max() for g in gaps) <= step + 1e-9
+    assert np.maximum(*gaps).min() > 0.75 * step  # no crowding on both rings at once
+
+
+def test_rows_in_the_sharp_corner_run_longer_than_the_band():
+    # in the outline's sharp bottom-right corner the band is 25 sqrt(2) wide along the bisector
+    start, end = _rows(bp.PaperPocket(outline_scale=1.0, band_mm=25.0, chord_tol_mm=1e-3))
     assert np.linalg.norm(end - start, axis=1).max() > 25.0
 
 

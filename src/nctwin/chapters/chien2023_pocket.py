@@ -1,17 +1,23 @@
 r"""Calibration of the band pockets of Chien et al. (2023) Tables 2 and 3
 (:mod:`nctwin.programs.band_pocket`) against the statistics the paper publishes.
 
-Each of a pocket's three settings is fixed by one statistic, never by a network's error:
+Each of a pocket's settings is fixed by one statistic, never by a network's error:
 
 * ``outline_scale`` by the path length :math:`\sum_k l_k`: the mean over the table's rows of
   what its CAM times imply, :math:`T_\mathrm{CAM} F` (CAM runs every G-line at :math:`F`);
 * ``chord_tol_mm`` by the number of G-lines of the pocketing path (the summary's
   ``pocketing_glines``; Table 3's pocket, for which the paper prints no count, takes Table 2's
-  chordal tolerance: the same CAM settings on a smaller part);
+  chordal tolerance: the same post-processor on another part);
 * ``band_mm`` by CAM's error :math:`|T_\mathrm{CAM} - T| / T` on the table's rows, run on the
   FIR kernel of the table's machine (:func:`nctwin.chapters.chien2023.simulate_one`): the band
   where the mean difference from the paper's printed errors changes sign (a narrower band has
-  shorter rows and more corners per metre, so CAM misses by more).
+  shorter rows and more corners per metre, so CAM misses by more);
+* ``stepover_mm`` (the paper prints none; 2 mm, a quarter of the 8 mm end mill) stays at that
+  unless even the widest band a part of the table's path allows leaves CAM missing by more than
+  the paper's. Then the band stays the widest and the stepover is solved for CAM's error instead,
+  up to the tool's diameter :math:`2R` (beyond it the rows would leave ridges uncut): a wider
+  stepover clears the same path's area with fewer rows, so the same path length belongs to a
+  larger part, whose wider band has longer rows and fewer corners per metre.
 
 :func:`solve_pocket` solves them for one pocket and :func:`cam_errors` gives the statistics; the
 solved numbers are frozen in :data:`nctwin.programs.band_pocket.PAPER_POCKETS`.
@@ -87,25 +93,29 @@ def _smallest_scale(band_mm: float) -> float:
     return math.ceil(1e5 * band_mm / BAND_MAX_PER_SCALE_MM) / 1e5
 
 
-def _widest_band(targets: dict[str, float], low_mm: float) -> float:
-    """The widest band whose pocket can still be as short as ``targets["path_m"]``: its
-    smallest part (the island's chamfer collapsed) has that path."""
+def _widest_band(targets: dict[str, float], stepover_mm: float) -> float:
+    """The widest band (mm, 3 decimals) whose pocket at ``stepover_mm`` can still be as short as
+    ``targets["path_m"]``: its smallest part (the island's chamfer collapsed) has that path."""
 
     def excess(band_mm: float) -> float:
         spec = PaperPocket(outline_scale=_smallest_scale(band_mm), band_mm=band_mm,
-                           chord_tol_mm=1e-4)  # fmt: skip
+                           chord_tol_mm=1e-4, stepover_mm=stepover_mm)  # fmt: skip
         return _stats(spec)["path_m"] - targets["path_m"]
 
+    low = 2 * PaperPocket.tool_radius_mm + stepover_mm
     high = BAND_MAX_PER_SCALE_MM * 5.0
-    return high if excess(high) < 0 else _bisect(excess, low_mm, high, 20)
+    widest = high if excess(high) < 0 else _bisect(excess, low, high, 20)
+    return math.floor(1e3 * widest) / 1e3
 
 
 def _solve_geometry(
-    band_mm: float, targets: dict[str, float], chord_tol_mm: float | None
+    band_mm: float, targets: dict[str, float], chord_tol_mm: float | None, stepover_mm: float
 ) -> PaperPocket:
     """``outline_scale`` for the path and (unless given) ``chord_tol_mm`` for the G-lines at
-    ``band_mm``; the two are solved in turn twice (the chords change the path a little)."""
-    spec = PaperPocket(outline_scale=1.0, band_mm=band_mm, chord_tol_mm=chord_tol_mm or 1e-4)
+    ``band_mm`` and ``stepover_mm``; the two are solved in turn twice (the chords change the path
+    a little)."""
+    spec = PaperPocket(outline_scale=1.0, band_mm=band_mm, chord_tol_mm=chord_tol_mm or 1e-4,
+                       stepover_mm=stepover_mm)  # fmt: skip
     low_scale = _smallest_scale(band_mm)
     for _ in range(2):
         scale = _bisect(lambda s, spec=spec: _stats(_with(spec, outline_scale=s))["path_m"]
@@ -157,7 +167,10 @@ def solve_pocket(
     ``band_mm`` is bisected between :math:`2R` + the stepover and the widest band a pocket of the
     table's path allows, on the mean of (paper - ours) of CAM's error over the table's rows;
     each candidate first gets its scale and chordal tolerance. Where CAM misses by more than the
-    paper's even on the widest band, that band is the answer (the closest the part comes).
+    paper's even on the widest band, the band stays the widest and ``stepover_mm`` is bisected
+    the same way between the default and :math:`2R` (two decimals), each candidate with its own
+    widest band; where CAM misses by more even at :math:`2R`, that stepover is the answer (the
+    closest the part comes).
 
     Parameters
     ----------
@@ -169,7 +182,7 @@ def solve_pocket(
     chord_tol_mm : float, optional
         A chordal tolerance to keep (Table 3: Table 2's); none: solved for the G-lines.
     iterations : int
-        Bisection steps on the band.
+        Bisection steps on the band (or the stepover).
 
     Returns
     -------
@@ -179,17 +192,28 @@ def solve_pocket(
         :func:`cam_errors` of the solved pocket.
     """
     targets = pocket_targets(table)
-    specs: dict[float, PaperPocket] = {}
+    specs: dict[tuple[float, float], PaperPocket] = {}
 
-    def excess(band_mm: float) -> float:
-        band_mm = round(band_mm, 3)
-        specs[band_mm] = _solve_geometry(band_mm, targets, chord_tol_mm)
-        errors = cam_errors(specs[band_mm], table, profile, recording)
+    def excess(band_mm: float, stepover_mm: float) -> float:
+        key = (round(band_mm, 3), stepover_mm)
+        specs[key] = _solve_geometry(key[0], targets, chord_tol_mm, stepover_mm)
+        errors = cam_errors(specs[key], table, profile, recording)
         return float((errors.paper_cam_err_pct - errors.cam_err_pct).mean())
 
-    base = PaperPocket(outline_scale=1.0, band_mm=20.0, chord_tol_mm=1e-4)
-    low = 2 * base.tool_radius_mm + base.stepover_mm
-    high = math.floor(1e3 * _widest_band(targets, low)) / 1e3
-    band = round(_bisect(excess, low, high, iterations), 3)
-    spec = specs.get(band) or _solve_geometry(band, targets, chord_tol_mm)
+    def at_widest(stepover_mm: float) -> float:
+        return excess(_widest_band(targets, stepover_mm), stepover_mm)
+
+    radius, step = PaperPocket.tool_radius_mm, PaperPocket.stepover_mm
+    if at_widest(step) >= 0:  # the paper's error lies within this stepover's bands
+        band = _bisect(lambda b: excess(b, step), 2 * radius + step,
+                       _widest_band(targets, step), iterations)  # fmt: skip
+    else:  # the widest band, and the stepover solved (a wider one: fewer corners per metre)
+        if at_widest(2 * radius) < 0:
+            step = 2 * radius
+        else:
+            step = round(_bisect(lambda s: at_widest(round(s, 2)), step, 2 * radius,
+                                 iterations), 2)  # fmt: skip
+        band = _widest_band(targets, step)
+    key = (round(band, 3), step)
+    spec = specs.get(key) or _solve_geometry(key[0], targets, chord_tol_mm, step)
     return spec, cam_errors(spec, table, profile, recording)
