@@ -190,6 +190,16 @@ def _command_of_two_moves() -> _fir_command._Command:
     )
 
 
+def test_a_leading_dwell_leaves_the_end_in_the_last_block():
+    # the samples after the last move stay in its block, with or without a dwell first
+    for text in ("G1 X10 F600\nY10", "G4 P0.25\nG1 X10 F600\nY10"):
+        tp = parse(text)
+        block = fir.run(tp, MACHINE, SETTINGS).block
+        assert (np.diff(block) >= 0).all() and block[-1] == len(tp) - 1
+    targets = block_targets(fir.run(tp, MACHINE, SETTINGS), tp)
+    assert targets.time_s[0] == pytest.approx(0.25, abs=PERIOD_S)
+
+
 def test_command_knot_times_and_sample_blocks():
     cmd = _command_of_two_moves()
     # arrival at and departure from each cut: 10 ms, the pause, 10 ms
@@ -197,7 +207,7 @@ def test_command_knot_times_and_sample_blocks():
     halved = cmd.knot_times(np.array([0.5, 1.0]))
     np.testing.assert_allclose(halved, [0, 0, 0.02, 0.025, 0.035, 0.035], atol=1e-15)
     # two samples late: the first move owns samples 0-11, the pause 12-16, the second move
-    # 17-26, the last (unowned) pause takes the first pause's (unowned: kept[-1])
+    # 17-26, the last (unowned) pause takes the last move's
     kept = np.array([3, 5, 7])
     expected = np.repeat([3, 5, 7, 7], [12, 5, 10, 3])
     t_knots = cmd.knot_times()

@@ -62,9 +62,19 @@ def test_random_programs_stream_to_the_same_bits(lines, chunk):
                  chunk)  # fmt: skip
 
 
+def test_a_leading_dwell_streams_to_the_same_bits():
+    # the smallest program hypothesis found where the end's samples were the dwell's block
+    prof = load_profile("linuxcnc_sim")
+    tp = gcode.parse("G21 G90 G64 P0.05 F900\nG4 P0.275\nG0 X0 Y16\nG0 X0 Y0\n")
+    _assert_same(tp, prof.machine, prof.control_for("kernel"), 2 * SEARCH_SAMPLES + 2)
+
+
 def test_a_short_program_is_one_run_and_a_bad_chunk_is_refused():
     prof = load_profile("generic_mill")
     _assert_same(gcode.parse("G1 X1 F600\n"), prof.machine, prof.control_for("kernel"), 1 << 18)
-    with pytest.raises(ValueError, match="chunk_samples = 10 is out of range: allowed >= 502"):
+    with pytest.raises(
+        ValueError,
+        match="chunk_samples = 10 is out of range: allowed integers >= 502",
+    ):
         stream_block_targets(gcode.parse(HAND), prof.machine, prof.control_for("kernel"),
                              chunk_samples=10)  # fmt: skip

@@ -12,6 +12,7 @@ import numpy as np
 __all__ = [
     "best_time_s",
     "check_choice",
+    "check_int",
     "check_range",
     "whole_periods",
 ]
@@ -68,6 +69,27 @@ def check_range(
         extra = " or inf" if allow_inf else ""
         raise ValueError(f"{name} = {value!r} is out of range: allowed {interval}{extra}")
     return float(value)
+
+
+def check_int(name: str, value, low: int, high: float = math.inf) -> int:
+    """Raise ValueError naming ``name``, its value and the allowed integers, in one line, unless
+    ``value`` is an integer (numpy's too; not a bool) with ``low <= value <= high``.
+
+    Returns
+    -------
+    int
+        The value as a Python int.
+
+    >>> check_int("n_jobs", 2.0, 1)
+    Traceback (most recent call last):
+    ...
+    ValueError: n_jobs = 2.0 is out of range: allowed integers >= 1
+    """
+    ok = isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_)
+    if not (ok and low <= value <= high):
+        allowed = f">= {low}" if high == math.inf else f"in [{low}, {high:g}]"
+        raise ValueError(f"{name} = {value!r} is out of range: allowed integers {allowed}")
+    return int(value)
 
 
 def check_choice(name: str, value, allowed: tuple) -> None:

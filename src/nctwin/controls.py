@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .checks import check_choice, check_range, whole_periods
+from .checks import check_choice, check_int, check_range, whole_periods
 
 __all__ = [
     "CONTROLS",
@@ -100,9 +100,7 @@ class FirControl:
             raise ValueError(
                 f"rapid_ramp = {self.rapid_ramp!r} is out of range: allowed true, false"
             )
-        n = self.block_periods
-        if not (isinstance(n, int) and not isinstance(n, bool) and 0 <= n <= 100):
-            raise ValueError(f"block_periods = {n!r} is out of range: allowed integers in [0, 100]")
+        check_int("block_periods", self.block_periods, 0, 100)
         if max(self.t1_s, self.t2_s) < self.period_s:
             raise ValueError(
                 f"t1_s = {self.t1_s!r} is out of range: allowed [period_s, 10] for the longer of "

@@ -22,6 +22,8 @@ from typing import Any
 from joblib import Parallel, delayed, parallel_config
 from tqdm import tqdm
 
+from .checks import check_int
+
 __all__ = ["SCHEDULER_ENV", "run_tasks", "scheduler_address"]
 
 #: Environment variable naming a Dask scheduler to run tasks on.
@@ -66,8 +68,7 @@ def run_tasks(
     ValueError
         If ``n_jobs`` is not an integer >= 1.
     """
-    if not isinstance(n_jobs, int) or isinstance(n_jobs, bool) or n_jobs < 1:
-        raise ValueError(f"n_jobs = {n_jobs!r} is out of range: allowed integers >= 1")
+    check_int("n_jobs", n_jobs, 1)
     tasks = list(tasks)
     jobs = (delayed(fn)(*args) for args in tasks)
     address = None if threads else scheduler_address()

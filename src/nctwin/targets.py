@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .checks import check_int
 from .motion import Motion
 from .toolpath import MotionKind, Toolpath
 
@@ -121,8 +122,7 @@ def block_targets(
     -------
     BlockTargets
     """
-    if chunk_junctions < 1:
-        raise ValueError(f"chunk_junctions = {chunk_junctions!r} is out of range: allowed >= 1")
+    check_int("chunk_junctions", chunk_junctions, 1)
     n = len(toolpath)
     n_samples = len(motion)
     pos, label = motion.pos_mm, motion.block

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..checks import check_int
 from ..controls import FirControl
 from ..estimate.blend_planner import blend_planner
 from ..estimate.block_overlap import block_overlap
@@ -278,8 +279,7 @@ def planner_block_gaps(rec: RecordedProgram, profile: Profile, n: int = 3) -> pd
     """The ``n`` blocks of a recording of nctwin's own programs whose time the blend-arc planner
     misses most: block, kind, length (mm), programmed feed (mm/s), recorded and planned time
     (s), sorted by block."""
-    if not (isinstance(n, int) and n >= 1):
-        raise ValueError(f"n = {n!r} is out of range: allowed integers >= 1")
+    check_int("n", n, 1)
     if rec.source != "nctwin":
         raise ValueError(
             f"recording {rec.name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "

@@ -93,6 +93,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import check_int, check_range
 from ..toolpath import EVENT_DTYPE, PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
 from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
@@ -255,12 +256,10 @@ def read_linuxcnc(
             (5181, "g30_reference_mm", g30_reference_mm),
         )
     }
-    if not isinstance(max_moves, int) or max_moves < 1:
-        raise ValueError(f"max_moves must be an int >= 1, got {max_moves!r}")
+    check_int("max_moves", max_moves, 1)
     if timeout_s is None:
         timeout_s = timeout_for(len(text.encode("utf-8", "replace")))
-    if not (isinstance(timeout_s, int | float) and 0 < timeout_s < float("inf")):
-        raise ValueError(f"timeout_s must be a finite number > 0, got {timeout_s!r}")
+    check_range("timeout_s", timeout_s, 0.0, low_open=True, high_open=True)
     name = source or "<string>"
     if "\0" in text:
         line = text.count("\n", 0, text.index("\0")) + 1

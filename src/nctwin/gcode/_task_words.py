@@ -66,21 +66,19 @@ def task_words(before: np.ndarray, line: np.ndarray, state: np.ndarray):
     tool = ran & (now[:, 2] == 6)
     mist0, flood0 = _coolant(prev)
     mist1, flood1 = _coolant(now)
-    words = [  # (where, which lines, code) in the order a block runs them
-        (start, ran & (now[:, 1] != prev[:, 1]) & ~tool, now[:, 1]),
-        (start, ran & mist1 & ~mist0, np.full(len(now), 7.0)),
-        (start, ran & flood1 & ~flood0, np.full(len(now), 8.0)),
-        (start, ran & (mist0 | flood0) & ~(mist1 | flood1), np.full(len(now), 9.0)),
-        (start, tool, np.full(len(now), 6.0)),
-        (end, ran & np.isin(now[:, 0], (0, 1)), now[:, 0]),
-    ]
-    order = np.arange(len(now))
-    rows = [(order[m], k, where[m], v[m]) for k, (where, m, v) in enumerate(words)]
-    key = np.concatenate([r[0] for r in rows]) * len(words) + np.concatenate(
-        [np.full(len(r[0]), r[1]) for r in rows]
-    )
-    sort = np.argsort(key, kind="stable")
-    move = np.concatenate([r[2] for r in rows])[sort].astype(np.int64)
-    value = np.concatenate([r[3] for r in rows])[sort].astype(float)
-    word_line = np.concatenate([wrote[r[0]] for r in rows])[sort].astype(np.int64)
-    return move, word_line, value
+    n = len(now)
+    # one column per word, in the order a block runs them: spindle, mist, flood, coolant off,
+    # tool change (before the line's moves), stop (after them)
+    mask = np.column_stack([
+        ran & (now[:, 1] != prev[:, 1]) & ~tool,
+        ran & mist1 & ~mist0,
+        ran & flood1 & ~flood0,
+        ran & (mist0 | flood0) & ~(mist1 | flood1),
+        tool,
+        ran & np.isin(now[:, 0], (0, 1)),
+    ])  # fmt: skip
+    where = np.column_stack([start] * 5 + [end])
+    fixed = [np.full(n, m) for m in (7.0, 8.0, 9.0, 6.0)]
+    code = np.column_stack([now[:, 1], *fixed, now[:, 0]])
+    r, k = np.nonzero(mask)  # row-major: by line, then by the order above
+    return where[r, k].astype(np.int64), wrote[r].astype(np.int64), code[r, k].astype(float)

@@ -71,13 +71,14 @@ class _Command:
         block at the time segment ``delay`` samples before.
 
         ``t_knots`` (2C,) from :meth:`knot_times`: segment ``2c`` is the pause at cut ``c``, in
-        ``pause_block[c]``, or where that is -1 the next segment's (the last pause's: the first
-        segment's); segment ``2c + 1`` the move after it, in ``block[c]``. A segment owns the
-        samples from the first at or after its start (1e-9 periods of slack), ``delay`` on, up to
-        the next segment's; the first segment every sample before that too.
+        ``pause_block[c]``, or where that is -1 the next segment's (for the last pause, after
+        the program's last move, that move's); segment ``2c + 1`` the move after it, in
+        ``block[c]``. A segment owns the samples from the first at or after its start (1e-9
+        periods of slack), ``delay`` on, up to the next segment's; the first segment every
+        sample before that too.
         """
         seg = np.column_stack([self.pause_block, np.append(self.block, 0)]).ravel()[:-1]
-        seg = np.where(seg < 0, np.roll(seg, -1), seg)
+        seg = np.where(seg < 0, np.append(seg[1:], seg[-2] if len(seg) > 1 else -1), seg)
         first = np.ceil(t_knots[1:-1] / period_s - 1e-9).astype(np.int64) + delay
         edges = np.clip(np.concatenate([[i0], first, [i0 + n]]), i0, i0 + n)
         return np.repeat(kept[seg], np.diff(edges))

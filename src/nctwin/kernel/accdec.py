@@ -71,6 +71,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
+from ..checks import check_int
 from ..controls import AccDecControl
 from ..limits import path_limits
 from ..machine import Machine
@@ -435,8 +436,7 @@ def measure_inposition_times(
     ValueError
         If ``repeats`` < 1 or ``distance_mm`` is not ``0 < lo <= hi``.
     """
-    if not isinstance(repeats, int) or repeats < 1:
-        raise ValueError(f"repeats = {repeats!r} is out of range: allowed integers >= 1")
+    check_int("repeats", repeats, 1)
     lo, hi = distance_mm
     if not 0 < lo <= hi < math.inf:
         raise ValueError(f"distance_mm = {distance_mm!r} is out of range: allowed 0 < lo <= hi")

@@ -26,6 +26,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from ..checks import check_int
 from ..controls import FirControl
 from ..machine import Machine
 from ..targets import CHUNK_JUNCTIONS, BlockTargets, _junction_chunk, block_targets
@@ -166,8 +167,7 @@ def stream_block_targets(
         For ``chunk_samples`` out of range.
     """
     low = 2 * SEARCH_SAMPLES + 2
-    if not isinstance(chunk_samples, int) or chunk_samples < low:
-        raise ValueError(f"chunk_samples = {chunk_samples!r} is out of range: allowed >= {low}")
+    check_int("chunk_samples", chunk_samples, low)
     prep = prepare(toolpath, machine, control)
     ts = control.period_s
     if prep is None or prep.cmd.knot_times()[-1] / ts < chunk_samples:  # one chunk: a run

@@ -37,6 +37,7 @@ import torch
 from scipy import signal
 from scipy.optimize import least_squares
 
+from ..checks import check_range
 from ..learn.models import ModelConfig
 from ..learn.train import Trained, one_thread
 
@@ -83,10 +84,8 @@ class StribeckParams:
     shape: float = 2.0
 
     def __post_init__(self) -> None:
-        if not self.stribeck_mm_s > 0:
-            raise ValueError(f"stribeck_mm_s = {self.stribeck_mm_s!r} is out of range: allowed > 0")
-        if not self.shape > 0:
-            raise ValueError(f"shape = {self.shape!r} is out of range: allowed > 0")
+        check_range("stribeck_mm_s", self.stribeck_mm_s, 0.0, low_open=True)
+        check_range("shape", self.shape, 0.0, low_open=True)
 
 
 def stribeck_n(v_mm_s: np.ndarray, p: StribeckParams) -> np.ndarray:
@@ -136,8 +135,7 @@ def fit_restoring(
     cogging_n : ndarray, shape (G,)
         The residual of the line: the cogging lookup table.
     """
-    if not bin_mm > 0:
-        raise ValueError(f"bin_mm = {bin_mm!r} is out of range: allowed > 0")
+    check_range("bin_mm", bin_mm, 0.0, low_open=True)
     lo = max(np.min(pos_plus_mm), np.min(pos_minus_mm))
     hi = min(np.max(pos_plus_mm), np.max(pos_minus_mm))
     if not hi - lo > 2 * bin_mm:

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from ..checks import check_range
+from ..checks import check_int, check_range
 from .surfaces import ToolPath
 
 __all__ = [
@@ -138,8 +138,7 @@ def step_error_um(path: ToolPath, *, xtol: float = 1e-4, max_steps: int = 60) ->
         If ``xtol`` or ``max_steps`` is out of range.
     """
     check_range("xtol", xtol, 0.0, 0.01, low_open=True)
-    if not max_steps >= 1:
-        raise ValueError(f"max_steps = {max_steps!r} is out of range: allowed >= 1")
+    check_int("max_steps", max_steps, 1)
     seg = path.segments()
     radius = path.tool_radius_mm
     u0, u1, cl0 = seg["u0"], seg["u1"], seg["cl0"]
@@ -228,8 +227,7 @@ def step_error_iterative_um(
     ValueError
         If ``xatol`` is not > 0.
     """
-    if not xatol > 0:
-        raise ValueError(f"xatol = {xatol!r} is out of range: allowed > 0")
+    check_range("xatol", xatol, 0.0, low_open=True)
     seg = path.segments()
     surface, radius = path.surface, path.tool_radius_mm
     index = np.arange(path.n_segments) if segments is None else np.asarray(segments)
@@ -359,8 +357,7 @@ def step_error_samples(path: ToolPath, n_inner: int) -> np.ndarray:
     ValueError
         If ``n_inner`` < 1.
     """
-    if n_inner < 1:
-        raise ValueError(f"n_inner = {n_inner!r} is out of range: allowed >= 1")
+    check_int("n_inner", n_inner, 1)
     seg = path.segments()
     frac = np.arange(1, n_inner + 1) / (n_inner + 1)
     u = seg["u0"][:, None] + frac * (seg["u1"] - seg["u0"])[:, None]

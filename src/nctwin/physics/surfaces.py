@@ -35,7 +35,7 @@ from functools import cached_property
 import numpy as np
 from scipy import optimize
 
-from ..checks import check_range
+from ..checks import check_int, check_range
 from ..report.papers import load_paper_table
 
 __all__ = [
@@ -518,10 +518,8 @@ def iso_parametric_path(
     ValueError
         If a count or the radius is out of range.
     """
-    if n_lines < 1:
-        raise ValueError(f"n_lines = {n_lines!r} is out of range: allowed >= 1")
-    if n_points < 2:
-        raise ValueError(f"n_points = {n_points!r} is out of range: allowed >= 2")
+    check_int("n_lines", n_lines, 1)
+    check_int("n_points", n_points, 2)
     check_range("tool_radius_mm", tool_radius_mm, 0.0, np.inf, low_open=True, high_open=True)
     u = np.linspace(0.0, 1.0, n_points)
     v = np.linspace(0.0, 1.0, n_lines)

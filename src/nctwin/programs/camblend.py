@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_range
+from ..checks import check_int, check_range
 from .training import ProgramSpec, _log_uniform, _polyline, _rng, program_text, specs_of
 
 __all__ = [
@@ -107,8 +107,7 @@ def cam_blend_program(
     str
         G-code text (:func:`nctwin.programs.training.program_text`).
     """
-    if not (isinstance(n_lines, int) and n_lines >= 2):
-        raise ValueError(f"n_lines = {n_lines!r} is out of range: allowed integers >= 2")
+    check_int("n_lines", n_lines, 2)
     check_range("feed_mm_s", feed_mm_s, 0.0, 1000.0, low_open=True)
     check_range("tol_mm", tol_mm, 0.0, 10.0, low_open=True)
     lengths, turns = _sections(_rng(seed), n_lines)

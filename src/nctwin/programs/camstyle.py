@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from ..checks import check_int
 from .training import _log_uniform, _rng
 
 __all__ = ["CAM_KINDS", "PATH_MODES", "cam_program"]
@@ -112,8 +113,7 @@ def cam_program(
         G-code text: a comment with the settings, ``G21 G90 G17``, the path-control mode,
         then per operation ``G0 Z``, ``G0 X Y``, ``G1 Z F``, ``G1 ... F`` and the cut's lines.
     """
-    if not (isinstance(max_operations, int) and max_operations >= 1):
-        raise ValueError(f"max_operations = {max_operations!r} is out of range: allowed >= 1")
+    check_int("max_operations", max_operations, 1)
     rng = _rng(seed)
     feed = round(_log_uniform(rng, *feed_range_mm_s), 1)
     modes = list(PATH_MODES)

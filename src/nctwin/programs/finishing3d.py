@@ -106,7 +106,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import check_range
+from ..checks import check_int, check_range
 from ..gcode import parse
 from ..toolpath import MotionKind, Toolpath
 
@@ -176,8 +176,7 @@ class FinishingParams:
             ("lead_radius_mm", 100.0),
         ):
             check_range(name, getattr(self, name), 0.0, hi, low_open=True)
-        if not isinstance(self.bumps, int) or isinstance(self.bumps, bool) or self.bumps < 0:
-            raise ValueError(f"bumps = {self.bumps!r} is out of range: allowed integers >= 0")
+        check_int("bumps", self.bumps, 0)
         if self.max_segment_mm < 10 * self.tolerance_mm:
             raise ValueError(
                 f"max_segment_mm = {self.max_segment_mm!r} is out of range: allowed "

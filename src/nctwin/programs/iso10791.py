@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import check_range
+from ..checks import check_int, check_range
 from ..gcode import parse
 from ..paths import data_dir
 from ..toolpath import Toolpath
@@ -100,9 +100,7 @@ class TestPieceParams:
             check_range(name, getattr(self, name), 0.0, math.inf, low_open=True, high_open=True)
         check_range("dwell_s", self.dwell_s, 0.0, math.inf, high_open=True)
         for name, lo in (("passes", 1), ("repeats", 1), ("bore_segments", 8)):
-            v = getattr(self, name)
-            if not isinstance(v, int) or v < lo:
-                raise ValueError(f"{name} = {v!r} is out of range: allowed integers >= {lo}")
+            check_int(name, getattr(self, name), lo)
         if self.tool_radius_mm >= 15.0:
             raise ValueError(
                 f"tool_radius_mm = {self.tool_radius_mm!r} is out of range: allowed (0, 15) "
