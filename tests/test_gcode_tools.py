@@ -118,3 +118,16 @@ def test_a_tool_no_table_lists_is_still_estimated(tmp_path, capsys):
     assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["reader"] == "linuxcnc" and out["cycle_time_s"] == pytest.approx(1.0)
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+def test_the_tool_an_m6_loads_is_named_or_refused():
+    # LinuxCNC's preview module reports no tool in the spindle after M6: a G41 without D would
+    # be read with diameter 0 where LinuxCNC runs T1's 3 mm, so it is refused at its line
+    text = "G21 G90\nT1 M6\nG41 G1 X10 Y5 F600 (comp on)\nG1 X20\nG40 G1 X30\nM2\n"
+    with pytest.raises(GCodeError, match=r":3: G41/G42 without D and G43 without H take the size"):
+        parse(text, tool_table=SIM)
+    named = parse(text.replace("G41 ", "G41 D1 "), tool_table=SIM)
+    assert named.lengths_mm.sum() != pytest.approx(parse(text).lengths_mm.sum(), abs=1e-3)
+    # with nctwin's own table every tool has size 0: nothing depends on the spindle's tool
+    assert len(parse(text)) == 3

@@ -98,7 +98,7 @@ from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
 from ._splines import task_splines
 from ._task_words import M_COLUMNS, task_words
-from ._tools import LINUXCNC_TOOL_TABLE, ToolTable, complete_tool_table
+from ._tools import LINUXCNC_TOOL_TABLE, ToolTable, complete_tool_table, spindle_tool_line
 
 #: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
 LINUXCNC_PYTHON = "/usr/bin/python3"
@@ -273,6 +273,13 @@ def read_linuxcnc(
         )  # fmt: skip
     if not interpreter_available():
         raise GCodeError(0, "", _NOT_INSTALLED, source)
+    spindle = spindle_tool_line(tool_table, text)
+    if spindle is not None:
+        raise GCodeError(
+            spindle, "", "G41/G42 without D and G43 without H take the size of the tool M6 put"
+            " in the spindle, which LinuxCNC's preview module (this reader) never loads: name"
+            " the tool (G41 D<n>, G43 H<n>)", source,
+        )  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:
         program = Path(tmp) / "program.ngc"
         program.write_text(_instrument(text.replace("\r\n", "\n").replace("\r", "\n")))

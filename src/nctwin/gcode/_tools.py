@@ -60,6 +60,34 @@ def complete_tool_table(table: str, program: str) -> str:
     return table + ("" if not added or table.endswith("\n") else "\n") + added
 
 
+#: A tool change (M6, M61) and the codes that take the size of the tool in the spindle when
+#: they name no tool: G41/G42 without D, G43 without H (not G41.1, G42.1, G43.1, G43.2).
+_CHANGE = re.compile(r"(?<![A-Z0-9.#])M0*6(?:1)?(?![.\d])", re.IGNORECASE)
+_SPINDLE_SIZED = {
+    "D": re.compile(r"(?<![A-Z0-9.#])G0*4[12](?![.\d])", re.IGNORECASE),
+    "H": re.compile(r"(?<![A-Z0-9.#])G0*43(?![.\d])", re.IGNORECASE),
+}
+
+
+def spindle_tool_line(table: ToolTable | None, program: str) -> int | None:
+    """The first line (1-based) of ``program`` that takes its size from the tool an ``M6`` put
+    in the spindle (``G41``/``G42`` without ``D``, ``G43`` without ``H``), where ``table``
+    gives some tool a size; None if there is none. LinuxCNC's preview module, which the
+    interpreter reader runs, answers "no tool" for the spindle after every tool change
+    (``GET_EXTERNAL_TOOL_SLOT`` in gcodemodule.cc), so such a line would be read with size 0
+    where LinuxCNC runs the tool's size."""
+    if table is None or not (any(table.diameter_mm) or any(map(any, table.offset_mm))):
+        return None
+    if not _CHANGE.search(_NOT_WORDS.sub(" ", program)):
+        return None
+    for i, line in enumerate(program.splitlines(), 1):
+        words = _NOT_WORDS.sub(" ", line)
+        for letter, code in _SPINDLE_SIZED.items():
+            if code.search(words) and not re.search(rf"(?<![A-Z]){letter}(?![A-Z])", words, re.I):
+                return i
+    return None
+
+
 def tool_table_of(
     tool_table: str | PathLike | ToolTable | None, source: str | None
 ) -> ToolTable | None:
