@@ -39,6 +39,7 @@ from nctwin import MotionKind, PathMode, Toolpath
 from nctwin.gcode import (
     GCodeError,
     _interp,
+    complete_tool_table,
     interpreter_available,
     parse,
     parse_file,
@@ -468,7 +469,7 @@ def test_without_linuxcnc(monkeypatch):
 def test_bad_reader_arguments():
     with pytest.raises(ValueError, match=r"reader = 'rs274' is not allowed: allowed 'native'"):
         parse("G0 X1", reader="rs274")
-    with pytest.raises(ValueError, match=r"tool_table = 't\.tbl' is not allowed with reader='nat"):
+    with pytest.raises(GCodeError, match=r"tool table t\.tbl: No such file"):
         parse("G0 X1", reader="native", tool_table="t.tbl")
     with pytest.raises(ValueError, match="dwell_p_unit = 'ms' is not allowed with reader='lin"):
         parse("G0 X1", reader="linuxcnc", dwell_p_unit="ms")
@@ -486,16 +487,16 @@ def test_auto_reports_the_reader(linuxcnc_interpreter):
 def test_a_tool_table_is_completed_only_where_no_size_is_needed():
     table = "T1 P1 D0 Z0 ;\nT5 P7 D6 Z1 ;\n"
     # T2 and T9 are added after the largest pocket (7), of size 0; T0 and T1 are not
-    assert _interp.complete_tool_table(table, "T2 M6\nT0\n(T3 in a comment)\nT1 G1 X1\nT9\n") == (
+    assert complete_tool_table(table, "T2 M6\nT0\n(T3 in a comment)\nT1 G1 X1\nT9\n") == (
         table + "T2 P8 D0 Z0 ;not in the table\nT9 P9 D0 Z0 ;not in the table\n"
     )
     # cutter compensation or a length offset needs the table's sizes: nothing is added
     for code in ("G41 D2", "G42", "G43 H2", "G43.2 H2", "G041"):
-        assert _interp.complete_tool_table(table, f"T2 M6\n{code} G1 X1\n") == table
+        assert complete_tool_table(table, f"T2 M6\n{code} G1 X1\n") == table
     # dynamic compensation and offsets carry their size in the block; GT is an operator
     for code in ("G41.1 D4", "G43.1 Z2", "O100 if [#1 GT 2]"):
-        assert _interp.complete_tool_table(table, f"T2 M6\n{code}\n") != table
-    assert _interp.complete_tool_table("T1 P1 D0 Z0 ;", "T2") == (
+        assert complete_tool_table(table, f"T2 M6\n{code}\n") != table
+    assert complete_tool_table("T1 P1 D0 Z0 ;", "T2") == (
         "T1 P1 D0 Z0 ;\nT2 P2 D0 Z0 ;not in the table\n"
     )
 

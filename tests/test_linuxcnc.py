@@ -317,3 +317,15 @@ def test_experiment_conditions_by_hand():
     )
     conds = {c.id: c for c in rk.experiment_conditions(recordings, programs, finite)}
     assert conds["startup_mode_programs"].ours == 1.0 and not conds["startup_mode_programs"].met
+
+
+@live
+def test_the_sims_tool_table_offsets_the_live_tool():
+    # G43 H1 with LinuxCNC's sim table (T1 0.511 mm long): the Z move ends 0.511 mm higher, as
+    # the native reader reads it; with nctwin's own table (T1 of length 0) at the programmed Z
+    text = "G21 G90 G61\nG43 H1\nG1 Z5 F3000\nG1 X10\nM2\n"
+    m = lc.run(text, MACHINE, PLANNER, tool_table=PROFILE.tool_table)
+    np.testing.assert_allclose(m.pos_mm[-1], [10.0, 0.0, 5.511], atol=1e-6)
+    tp = parse(text, tool_table=PROFILE.tool_table)
+    np.testing.assert_allclose(tp.end_mm[-1], m.pos_mm[-1], atol=1e-6)
+    np.testing.assert_allclose(lc.run(text, MACHINE, PLANNER).pos_mm[-1], [10, 0, 5], atol=1e-6)

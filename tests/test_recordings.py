@@ -75,7 +75,7 @@ def _text(name: str) -> str:
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_recording_is_consistent(name):
     rec = SHIPPED[name]
-    tp = parse(_text(name))
+    tp = parse(_text(name), tool_table=PROFILE.tool_table)
     t = rec.targets
     assert len(t.time_s) == len(tp) == len(t.length_mm) == len(t.junction_sample) - 1
     # the junctions cover the whole trace: the block times add up to the recorded duration

@@ -310,8 +310,9 @@ def _program_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tool-table",
         metavar="TBL",
-        help="LinuxCNC tool table (.tbl) for tool lengths (G43) and diameters (G41/G42 D) when "
-        "LinuxCNC's interpreter reads the program (default: one tool, T1, of diameter 0)",
+        help="LinuxCNC tool table (.tbl) for tool lengths (G43 H) and diameters (G41/G42 D) "
+        "(default: the machine profile's tool_table, LinuxCNC's sim table for linuxcnc_sim; "
+        "without one, one tool, T1, of size 0)",
     )
 
 
@@ -384,6 +385,8 @@ def _load(args: argparse.Namespace, stage: _Stages) -> tuple[Profile, Toolpath, 
         if not table.is_file():
             raise InputError(f"{args.tool_table}: no such tool table file")
         kwargs["tool_table"] = args.tool_table
+    elif profile.tool_table is not None:
+        kwargs["tool_table"] = profile.tool_table
     result = read(text, reader=args.reader, **kwargs)
     tp = result.toolpath
     if not ((tp.lengths_mm > 0).any() or (tp.dwell_s > 0).any()):

@@ -7,8 +7,11 @@ feed), one ``[control.<kind>]`` table per control model it is described for
 ``sequence``), and three
 top-level keys: ``default_method``, the method ``nctwin estimate`` uses when none is named,
 ``recordings``, the shipped recordings of this machine the learned methods train on (if any),
-and ``dialect``, the G-code dialect ``nctwin estimate`` and ``nctwin simulate`` read its
-programs in (:data:`DIALECTS`; default ``"rs274ngc"``).
+``dialect``, the G-code dialect ``nctwin estimate`` and ``nctwin simulate`` read its
+programs in (:data:`DIALECTS`; default ``"rs274ngc"``), and ``tool_table``, the machine's
+LinuxCNC tool table (:class:`ToolTable`), a ``.tbl`` file named relative to the profile's
+folder or, failing that, to the shipped profiles' (default: none, the readers' own table of
+tool 1 with size 0).
 No key is written twice, and an unknown or misspelt key is refused with the file, the table and
 the key. Values fitted to recordings are written into the file by a command
 (:func:`write_control`), never looked up elsewhere at run time, so a copy of a profile under
@@ -28,6 +31,7 @@ another name is the same machine.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import MISSING, dataclass, fields
 from datetime import date
@@ -51,10 +55,12 @@ __all__ = [
     "METHOD_CONTROLS",
     "Machine",
     "Profile",
+    "ToolTable",
     "available_machines",
     "load_machine",
     "load_profile",
     "profile_path",
+    "read_tool_table",
     "write_control",
 ]
 
@@ -131,6 +137,82 @@ class Machine:
         )
 
 
+#: The words of a LinuxCNC tool table's line (tooldata.cc): tool, pocket, offsets, diameter,
+#: front and back angles, orientation.
+_TABLE_WORD = re.compile(r"([TPXYZABCUVWDIJQ])\s*([-+]?(?:\d+\.?\d*|\.\d+))\s*", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class ToolTable:
+    """A LinuxCNC tool table (``.tbl``): each line ``T<n> P<pocket> X.. Y.. Z.. D.. ;comment``,
+    lengths in the machine's units (mm on nctwin's LinuxCNC machines).
+
+    Parameters
+    ----------
+    text : str
+        The table as LinuxCNC reads it (written to a LinuxCNC instance's ``tool.tbl``).
+    tools : tuple of int
+        Tool numbers, shape (N,), in the table's order.
+    offset_mm : tuple of (float, float, float)
+        X, Y, Z offsets of each tool (what ``G43 H<n>`` adds), shape (N, 3).
+    diameter_mm : tuple of float
+        Diameter of each tool (what cutter compensation ``G41``/``G42 D<n>`` offsets by half
+        of), shape (N,).
+    """
+
+    text: str
+    tools: tuple[int, ...]
+    offset_mm: tuple[_XYZ, ...]
+    diameter_mm: tuple[float, ...]
+
+    def offset_of(self, tool: int) -> _XYZ | None:
+        """The X, Y, Z offsets of ``tool`` (mm); None if the table lacks it. Tool 0 (no tool)
+        has none."""
+        if tool == 0:
+            return (0.0, 0.0, 0.0)
+        return self.offset_mm[self.tools.index(tool)] if tool in self.tools else None
+
+
+def read_tool_table(text: str, source: str = "tool.tbl") -> ToolTable:
+    """Read a LinuxCNC tool table's text (see :class:`ToolTable`).
+
+    Raises
+    ------
+    ValueError
+        One line, ``source:line: reason``, for a line LinuxCNC would not read (a word it does
+        not know, a number it cannot read, no T word, a tool listed twice).
+    """
+    tools, offsets, diameters = [], [], []
+    for i, line in enumerate(text.splitlines(), 1):
+        body = line.split(";", 1)[0].strip()
+        if not body:
+            continue
+        words: dict[str, float] = {}
+        at = 0
+        while at < len(body):
+            m = _TABLE_WORD.match(body, at)
+            if m is None:
+                raise ValueError(
+                    f"{source}:{i}: cannot read {body[at:].split()[0]!r}: a tool"
+                    " table line is T<n> P<pocket> X Y Z ... D<diameter> ;comment"
+                )
+            letter = m.group(1).upper()
+            if letter in words:
+                raise ValueError(f"{source}:{i}: {letter} given twice")
+            words[letter], at = float(m.group(2)), m.end()
+        tool = words.get("T")
+        if tool is None or tool != int(tool) or tool < 1:
+            raise ValueError(f"{source}:{i}: no tool number (T<n>, a whole number >= 1)")
+        if int(tool) in tools:
+            raise ValueError(f"{source}:{i}: tool {int(tool)} listed twice")
+        if words.get("D", 0.0) < 0:
+            raise ValueError(f"{source}:{i}: diameter D must be >= 0")
+        tools.append(int(tool))
+        offsets.append(tuple(words.get(a, 0.0) for a in "XYZ"))
+        diameters.append(words.get("D", 0.0))
+    return ToolTable(text, tuple(tools), tuple(offsets), tuple(diameters))
+
+
 @dataclass(frozen=True)
 class Profile:
     """A machine profile: the machine, its controls, and the profile's default method.
@@ -150,6 +232,9 @@ class Profile:
     dialect : {"rs274ngc", "fanuc"}
         The G-code dialect ``nctwin estimate`` and ``nctwin simulate`` read the machine's
         programs in (:func:`nctwin.gcode.parse`'s ``dialect``).
+    tool_table : ToolTable or None
+        The machine's tools, which the readers (``G43 H`` lengths, ``G41``/``G42 D``
+        diameters) and the LinuxCNC kernel use for its programs; None: the readers' own.
     """
 
     machine: Machine
@@ -161,6 +246,7 @@ class Profile:
     default_method: str = "cam"
     recordings: str | None = None
     dialect: str = "rs274ngc"
+    tool_table: ToolTable | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.machine, Machine):
@@ -185,6 +271,10 @@ class Profile:
                 "recordings' name"
             )
         check_choice("dialect", self.dialect, DIALECTS)
+        if self.tool_table is not None and not isinstance(self.tool_table, ToolTable):
+            raise ValueError(
+                f"tool_table = {self.tool_table!r} is out of range: allowed a ToolTable or None"
+            )
 
     @property
     def name(self) -> str:
@@ -243,7 +333,7 @@ class Profile:
         """
         p = Path(path)
         data = _read_toml(p)
-        top = {"machine", "control", "default_method", "recordings", "dialect"}
+        top = {"machine", "control", "default_method", "recordings", "dialect", "tool_table"}
         _refuse_unknown(p, "", data, top)
         machine_table = data.get("machine")
         if not isinstance(machine_table, dict):
@@ -259,6 +349,7 @@ class Profile:
             if not isinstance(table, dict):
                 raise ValueError(f"{p}: control.{kind} must be a table ([control.{kind}])")
             controls[kind] = _build(p, f"[control.{kind}]", CONTROLS[kind], table)
+        tools = _profile_tools(p, data.get("tool_table"))
         try:
             return cls(
                 machine,
@@ -266,9 +357,27 @@ class Profile:
                 default_method=data.get("default_method", "cam"),
                 recordings=data.get("recordings"),
                 dialect=data.get("dialect", "rs274ngc"),
+                tool_table=tools,
             )
         except ValueError as exc:
             raise ValueError(f"{p}: {exc}") from None
+
+
+def _profile_tools(p: Path, name) -> ToolTable | None:
+    """The tool table a profile names, read: a path relative to the profile's folder, or to
+    the shipped profiles' folder (so that a copy of a shipped profile elsewhere keeps it)."""
+    if name is None:
+        return None
+    if not (isinstance(name, str) and name):
+        raise ValueError(f"{p}: tool_table = {name!r} is out of range: allowed a .tbl file's path")
+    table = p.parent / name
+    if not table.is_file() and (machines_dir() / name).is_file():
+        table = machines_dir() / name
+    try:
+        text = table.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"{p}: tool_table: cannot read {table}: {exc.strerror or exc}") from None
+    return read_tool_table(text, str(table))
 
 
 def _read_toml(p: Path) -> dict:

@@ -181,7 +181,7 @@ def record_program(
     LinuxCNC aborts (a busy machine) is repeated up to :data:`RETRIES` times.
     Raises what :func:`nctwin.kernel.linuxcnc.run` raises.
     """
-    tp = parse(program)
+    tp = parse(program, tool_table=profile.tool_table)
     for attempt in range(RETRIES + 1):
         try:
             motion = linuxcnc.run(
@@ -190,6 +190,7 @@ def record_program(
                 profile.control("planner"),
                 speed=speed,
                 timeout_s=timeout_s,
+                tool_table=profile.tool_table,
             )
             break
         except linuxcnc.LinuxCNCAborted:
@@ -255,7 +256,7 @@ def _record_public_one(
 ) -> RecordedProgram | tuple[str, str]:
     text = path.read_text(encoding="utf-8", errors="replace")
     try:
-        tp = parse(text, source=path.name)
+        tp = parse(text, source=path.name, tool_table=profile.tool_table)
         cam_s = estimate_cam(tp, profile.machine).cycle_time_s
         # generous: LinuxCNC takes up to several times the CAM time on short segments
         timeout_s = 120.0 + 20.0 * cam_s / speed

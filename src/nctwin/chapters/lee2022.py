@@ -493,14 +493,14 @@ def out_of_domain_table(recordings: dict[str, RecordedProgram]) -> pd.DataFrame:
     for name, rec in recordings.items():
         g = groups.setdefault(name.split("_")[0], {"err": [], "cam": [], "not_read": []})
         text = public_program_text(rec)
+        profile = load_profile(rec.machine)
         try:
-            tp = parse(text) if text is not None else None
+            tp = parse(text, tool_table=profile.tool_table) if text is not None else None
         except GCodeError:
             tp = None
         if tp is None:
             g["not_read"].append(name)
             continue
-        profile = load_profile(rec.machine)
         machine = profile.machine
         lee = identified_block_overlap(tp, machine, profile.control("planner").period_s)
         pred = block_overlap(tp, machine, lee).cycle_time_s

@@ -169,7 +169,7 @@ def your_program(
     machine, planner = profile.machine, profile.control("planner")
 
     def method(text: str, source: str) -> ProgramResult:
-        tp = parse(text, source=source)
+        tp = parse(text, source=source, tool_table=profile.tool_table)
         times = analytic_times(tp, profile, fir_fitted, planner_fitted)
         data = move_data(source, tp, machine, planner)
         times["bilstm"] = predict_bilstm(bilstm, data)
@@ -182,7 +182,7 @@ def your_program(
         truth, why = None, linuxcnc.available()
         if why is None:
             try:
-                motion = linuxcnc.run(text, machine, planner)
+                motion = linuxcnc.run(text, machine, planner, tool_table=profile.tool_table)
             except (linuxcnc.LinuxCNCAborted, TimeoutError) as exc:
                 why = f"LinuxCNC did not finish it: {exc}"
             else:
@@ -285,7 +285,7 @@ def planner_block_gaps(rec: RecordedProgram, profile: Profile, n: int = 3) -> pd
             f"recording {rec.name!r} has source = {rec.source!r}: allowed 'nctwin' (a program "
             "whose text is shipped)"
         )
-    tp = parse(rec.program)
+    tp = parse(rec.program, tool_table=profile.tool_table)
     planned = blend_planner(tp, profile.machine, profile.control("planner")).block_times_s
     measured = rec.targets.time_s
     worst = np.sort(np.argsort(-np.abs(planned - measured), kind="stable")[:n])
@@ -339,11 +339,12 @@ def evaluation_programs(
         skipped).
     """
     machine, planner = profile.machine, profile.control("planner")
+    tools = profile.tool_table
     programs = {}
     for name, rec in recordings.items():
         if name.startswith("test_"):
             data = recorded_move_data(rec, machine, planner)
-            programs[name] = ("test paths", parse(rec.program), data)
+            programs[name] = ("test paths", parse(rec.program, tool_table=tools), data)
             continue
         if name.startswith("lang_"):
             group, text = "language", rec.program
@@ -354,7 +355,7 @@ def evaluation_programs(
         else:
             continue
         if text is not None:  # scored on the cycle time alone (arcs give no per-move targets)
-            tp = parse(text)
+            tp = parse(text, tool_table=tools)
             data = move_data(rec.name, tp, machine, planner)
             data = dataclasses.replace(data, measured_s=rec.cycle_time_s)
             programs[name] = (group, tp, data)
@@ -378,7 +379,7 @@ def _value(row: pd.Series | None, column: str):
 EVERY_PROGRAM_SETS = ("public", "samples", "language")
 #: The experiment's design: recordings per set (the recording's name up to its first ``_``).
 DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 8, "public": 14,
-                 "sample": 13}  # fmt: skip
+                 "sample": 12}  # fmt: skip
 #: The claims on the public programs, which need every program's path-control mode known
 #: (condition ``startup_mode_programs`` of :func:`experiment_conditions`).
 PUBLIC_CLAIMS = ("best_median_public", "best_worst_public", "best_beats_cam_public",

@@ -47,9 +47,12 @@ in ``convert_length_units``).
 * Modal state: G17/G18/G19, G20/G21 (converted to mm), G90/G91, G90.1/G91.1, G94 (which runs
   before the F of its line and clears the feed, as LinuxCNC's does), G98/G99, F.
   A G80 beside another motion code of its line gives way to it, as in LinuxCNC (``read_g``).
-* Prologue codes kept as state with no motion: G40, G43 (H; tool lengths are taken as zero),
-  G49, G53 (machine coordinates, ignoring G92; work offsets are taken as zero), G54-G59.3, G80,
-  G61, G61.1 and G64 with P (blending tolerance) and Q (naive CAM tolerance).
+* Prologue codes kept as state with no motion: G40, G43 H and G49 (the tool's offsets from
+  ``tool_table=``, zero without one; they shift the program's coordinates as LinuxCNC's do,
+  so the tool moves by them at the next absolute move of the axis; a canned cycle under a
+  non-zero offset and G43 without H need LinuxCNC's interpreter), G53 (machine coordinates,
+  ignoring G92; work offsets are taken as zero), G54-G59.3, G80, G61, G61.1 and G64 with P
+  (blending tolerance) and Q (naive CAM tolerance).
 * N numbers, ``( )`` and ``;`` comments, block delete ``/`` (off by default: the block runs, as
   with the switch off), ``%`` tape markers, Fanuc program numbers (a line that is only ``O1234``
   and a comment), M, S and T words (kept as events), any case, with or without spaces. M2 and M30
@@ -96,9 +99,12 @@ as the same :class:`~nctwin.toolpath.Toolpath` (its G5/G5.1 splines as the biarc
 task runs, :mod:`nctwin.gcode._splines`, not the preview's lines; of the M, S and T words it
 keeps the M-words LinuxCNC's task waits for, as far as the interpreter's modal state shows them,
 :mod:`nctwin.gcode._task_words`); it takes a LinuxCNC tool table
-(``tool_table=``, default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC
-configuration); a tool the table lacks runs with size 0 unless the program's cutter
-compensation or length offset needs its size (:func:`complete_tool_table`). ``"auto"`` is the
+(``tool_table=``: a machine profile's :class:`~nctwin.machine.ToolTable`, such as
+``linuxcnc_sim``'s, LinuxCNC's own sim table, or a ``.tbl`` file; default
+:data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's own LinuxCNC configuration); a tool the
+table lacks runs with size 0 unless the program's cutter compensation or length offset needs
+its size (:func:`complete_tool_table`). The native reader takes the tool length offsets of
+``G43 H<n>`` from the same table (:mod:`nctwin.gcode._tools`). ``"auto"`` is the
 native reader, and where that refuses only constructs that need the interpreter, the
 interpreter if :func:`interpreter_available`; otherwise the native error stands. The two agree
 to 1e-6 mm on every program both read (``tests/test_gcode_interp.py``).
@@ -115,16 +121,17 @@ from ._dump import dump
 from ._errors import MAX_ERRORS as MAX_ERRORS
 from ._errors import GCodeError
 from ._fanuc import DIALECTS as DIALECTS
-from ._interp import LINUXCNC_TOOL_TABLE as LINUXCNC_TOOL_TABLE
 from ._interp import MAX_MOVES as MAX_MOVES
 from ._interp import TIMEOUT_BASE_S as TIMEOUT_BASE_S
 from ._interp import TIMEOUT_S_PER_MB as TIMEOUT_S_PER_MB
-from ._interp import complete_tool_table, interpreter_available
+from ._interp import interpreter_available
 from ._modal import MAX_BLOCKS_PER_LINE as MAX_BLOCKS_PER_LINE
 from ._modal import MM_PER_INCH as MM_PER_INCH
 from ._reader import read_text
 from ._select import READERS as READERS
 from ._select import ReadResult, parse, parse_file, read, read_file
+from ._tools import LINUXCNC_TOOL_TABLE as LINUXCNC_TOOL_TABLE
+from ._tools import complete_tool_table
 
 __all__ = [
     "GCodeError",

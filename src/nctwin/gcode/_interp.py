@@ -99,12 +99,10 @@ from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
 from ._splines import task_splines
 from ._task_words import M_COLUMNS, task_words
+from ._tools import LINUXCNC_TOOL_TABLE, ToolTable, complete_tool_table, spindle_tool_line
 
 #: The Python that LinuxCNC's ``gcode`` module is built for (Debian's linuxcnc-uspace).
 LINUXCNC_PYTHON = "/usr/bin/python3"
-#: The tool table of nctwin's LinuxCNC configuration (:mod:`nctwin.kernel.linuxcnc` writes this
-#: text to its instance's ``tool.tbl``): tool 1 in pocket 1, diameter 0, length 0.
-LINUXCNC_TOOL_TABLE = "T1 P1 D0 Z0 ;\n"
 #: Most canonical moves one program may make; beyond it the reader stops (endless loops).
 MAX_MOVES = 2_000_000
 #: Wall-clock limit of the interpreter: this many seconds ...
@@ -202,7 +200,7 @@ def read_linuxcnc(
     folder: str | PathLike | None = None,
     units: str = "mm",
     block_delete: bool = False,
-    tool_table: str | PathLike | None = None,
+    tool_table: ToolTable | None = None,
     g28_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     g30_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     max_moves: int = MAX_MOVES,
@@ -223,9 +221,10 @@ def read_linuxcnc(
         Units in force before the program's own G20/G21.
     block_delete : bool
         Whether the block-delete switch is on.
-    tool_table : path, optional
-        A LinuxCNC tool table (``.tbl``) for tool lengths (G43) and diameters (G41/G42 D);
-        default :data:`LINUXCNC_TOOL_TABLE`, the table of nctwin's LinuxCNC configuration.
+    tool_table : ToolTable, optional
+        The machine's LinuxCNC tool table (:func:`nctwin.machine.read_tool_table`) for tool
+        lengths (G43) and diameters (G41/G42 D); default :data:`LINUXCNC_TOOL_TABLE`, the table
+        of nctwin's own LinuxCNC configuration.
     g28_reference_mm, g30_reference_mm : tuple of 3 floats
         The G28 and G30 reference points in machine coordinates (mm), written to the
         interpreter's parameters #5161-#5163 and #5181-#5183; default zero, as LinuxCNC's.
@@ -273,12 +272,17 @@ def read_linuxcnc(
         )  # fmt: skip
     if not interpreter_available():
         raise GCodeError(0, "", _NOT_INSTALLED, source)
+    spindle = spindle_tool_line(tool_table, text)
+    if spindle is not None:
+        raise GCodeError(
+            spindle, "", "G41/G42 without D and G43 without H take the size of the tool M6 put"
+            " in the spindle, which LinuxCNC's preview module (this reader) never loads: name"
+            " the tool (G41 D<n>, G43 H<n>)", source,
+        )  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:
         program = Path(tmp) / "program.ngc"
         program.write_text(_instrument(text.replace("\r\n", "\n").replace("\r", "\n")))
-        if tool_table is not None and not Path(tool_table).is_file():
-            raise GCodeError(0, "", f"tool table {tool_table} not found", source)
-        given = LINUXCNC_TOOL_TABLE if tool_table is None else Path(tool_table).read_text()
+        given = LINUXCNC_TOOL_TABLE if tool_table is None else tool_table.text
         table = Path(tmp) / "tool.tbl"
         table.write_text(complete_tool_table(given, text))
         job = {
@@ -304,41 +308,6 @@ def read_linuxcnc(
             _error_line(error, events), "", _reason(error[1], name, program, folder), source
         )
     return _toolpath(moves, events, modal, source)
-
-
-#: Comments, ``<names>`` of parameters and subroutines, and the words of a program's text.
-_NOT_WORDS = re.compile(r"\([^)]*\)|;[^\n]*|<[^>]*>")
-_WORDS = re.compile(r"(?<![A-Z])([GT])\s*(\d+(?:\.\d*)?)", re.IGNORECASE)
-_TABLE_TOOL = re.compile(r"^\s*T(\d+)(?:.*?\bP(\d+))?", re.IGNORECASE | re.MULTILINE)
-#: The G-codes that take a tool's size from the table: cutter compensation (its diameter) and
-#: tool length offsets (its length); G41.1, G42.1 and G43.1 give the size in the block.
-SIZED_CODES = (41.0, 42.0, 43.0, 43.2)
-
-
-def complete_tool_table(table: str, program: str) -> str:
-    """``table`` with each tool the program's T words select and the table lacks, of diameter
-    0 and length 0: a tool's size matters to the path only where cutter compensation or a length
-    offset needs it (:data:`SIZED_CODES`). A program with one of those gets ``table`` as it is,
-    and LinuxCNC refuses a tool it lacks. T0 (no tool) is never added.
-
-    Parameters
-    ----------
-    table : str
-        A LinuxCNC tool table's text (``T<n> P<pocket> D<diameter> Z<length> ;...`` lines).
-    program : str
-        The program's text: literal T and G words outside comments (T words computed from
-        parameters are not seen).
-    """
-    words = _WORDS.findall(_NOT_WORDS.sub(" ", program))
-    if any(k.upper() == "G" and float(v) in SIZED_CODES for k, v in words):
-        return table
-    listed = _TABLE_TOOL.findall(table)
-    missing = sorted({int(float(v)) for k, v in words if k.upper() == "T"} - {0}
-                     - {int(t) for t, _ in listed})  # fmt: skip
-    pocket = max((int(p) for _, p in listed if p), default=0)
-    added = "".join(f"T{t} P{pocket + k} D0 Z0 ;not in the table\n"
-                    for k, t in enumerate(missing, 1))  # fmt: skip
-    return table + ("" if not added or table.endswith("\n") else "\n") + added
 
 
 def _error_line(error: list, events: np.ndarray) -> int:
@@ -466,7 +435,8 @@ def _reason(message: str, name: str, program: Path, folder) -> str:
         message += (
             ", and the program's cutter compensation or length offset (G41, G42, G43) needs"
             " the sizes: give the machine's LinuxCNC tool table (tool_table=, nctwin"
-            " --tool-table FILE); nctwin's own holds T1 only, of diameter 0"
+            " --tool-table FILE, a profile's tool_table); nctwin's own holds T1 only, of"
+            " diameter 0"
         )
     return message
 

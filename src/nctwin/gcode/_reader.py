@@ -57,10 +57,10 @@ from ._modal import (
     _UNITS,
     MAX_BLOCKS_PER_LINE,
     MM_PER_INCH,
-    _anchored,
     _ffill,
     _fmt_g,
 )
+from ._tools import ToolTable, plain_positions, shift_by_offsets, tool_offsets
 
 
 def parse(
@@ -76,6 +76,7 @@ def parse(
     g30_reference_mm: tuple[float, float, float] = (0.0, 0.0, 0.0),
     arc_tol_mm: float = 0.005,
     arc_tol_rel: float = 0.001,
+    tool_table: ToolTable | None = None,
 ) -> Toolpath:
     """Read a part program.
 
@@ -109,6 +110,9 @@ def parse(
     arc_tol_mm, arc_tol_rel : float
         An arc whose start and end radii differ by more than
         ``max(arc_tol_mm, arc_tol_rel * radius)`` is rejected.
+    tool_table : ToolTable, optional
+        The machine's tools, whose offsets ``G43 H<n>`` applies (:mod:`._tools`); default
+        none: every offset 0, as on nctwin's own LinuxCNC table.
 
     Returns
     -------
@@ -162,18 +166,19 @@ def parse(
         references=references,
         arc_tol=(arc_tol_mm, arc_tol_rel),
         fanuc=dialect == "fanuc",
+        table=tool_table,
     )
     errors.raise_all(n_lines)
     return tp
 
 
 def _interpret(
-    words, n, errors: _Errors, *, inch, p_scale, start, references, arc_tol, fanuc
+    words, n, errors: _Errors, *, inch, p_scale, start, references, arc_tol, fanuc, table
 ) -> Toolpath:
     """Modal interpretation of the words of lines ``0..n-1``; returns the Toolpath.
 
     ``references`` (2, 3) holds the reference points of G28 and G30 (mm); ``fanuc``: the
-    program is in the fanuc dialect.
+    program is in the fanuc dialect; ``table``: the tool table (or None).
     """
     code, value, line = words["code"], words["value"], words["line"]
     W, has = _single_words(code, value, line, n, errors)
@@ -188,6 +193,11 @@ def _interpret(
     # ---- positions (machine coordinates: program coordinates plus the G92 offsets); a G28/G30
     # line ends with its axes at the reference point, whatever the offsets
     axis_val = np.stack([W["X"], W["Y"], W["Z"]], axis=1) * st.scale[:, None]
+    tlo = tool_offsets(W, has, G, n, table, errors)
+    if tlo.any():  # the tool length offsets, on the lines in absolute distance mode
+        axis_val = shift_by_offsets(axis_val, tlo, st.incremental, G)
+        under = f"a canned cycle under a tool length offset {_NEEDS_LINUXCNC}"
+        errors.at_lines(act.cycle_line & tlo.any(1), under)
     special = act.cycle_line | _IS_G92[G[_NONMODAL]]
     cycles: dict[int, list] = {}
     hl, home_mm = act.home_lines, act.home_mm
@@ -202,7 +212,7 @@ def _interpret(
             cycles,
         )  # fmt: skip
     else:
-        pos, off = _plain_positions(act, axis_val, st.incremental, start, n)
+        pos, off = plain_positions(act, axis_val, st.incremental, start, n)
     prev = np.vstack([start, pos[:-1]]) if n else pos
     # the intermediate point of each G28/G30 line: its axis words in the distance mode in force
     to = np.where(st.incremental[hl, None], prev[hl] + axis_val[hl], axis_val[hl] + off[hl])
@@ -455,20 +465,6 @@ def _motion_words(W, has, st: _Modal, act: _Actions, n, fanuc, errors: _Errors) 
         )
         turns = np.clip(p_turns, 1, MAX_BLOCKS_PER_LINE).astype(np.int64)
     return turns
-
-
-def _plain_positions(act: _Actions, axis_val, incremental, start, n):
-    """Positions (n, 3) of a program with no canned cycle and no G92, and its offsets (0)."""
-    off = np.zeros((n, 3))
-    pos = np.empty((n, 3))
-    for a in range(3):
-        step = np.where(act.axis_given[:, a] & incremental, axis_val[:, a], 0.0)
-        anchor = act.axis_given[:, a] & ~incremental
-        value_mm = axis_val[:, a].copy()
-        hl = act.home_lines
-        anchor[hl], value_mm[hl] = ~np.isnan(act.home_mm[:, a]), act.home_mm[:, a]
-        pos[:, a] = _anchored(anchor, value_mm, step, start[a])
-    return pos, off
 
 
 def _line_blocks(st: _Modal, act: _Actions, start, prev, pos, center, turns, via, dwell_t, cycles):

@@ -13,13 +13,14 @@ from ._fanuc import check_dialect
 from ._interp import interpreter_available, read_linuxcnc
 from ._reader import parse as parse_native
 from ._reader import read_text
+from ._tools import tool_table_of
 
 #: The values of ``reader``.
 READERS = ("native", "linuxcnc", "auto")
 #: Keyword arguments only the native reader takes (LinuxCNC has its own rules for them).
 _NATIVE_ONLY = ("dwell_p_unit", "dialect", "start_mm", "arc_tol_mm", "arc_tol_rel")
 #: Keyword arguments only LinuxCNC's interpreter takes.
-_LINUXCNC_ONLY = ("tool_table", "max_moves", "timeout_s", "folder")
+_LINUXCNC_ONLY = ("max_moves", "timeout_s", "folder")
 _NATIVE_DEFAULTS = {
     "dwell_p_unit": "s",
     "dialect": "rs274ngc",
@@ -72,15 +73,17 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
         error of the program, unless it names a construct only the interpreter reads: then the
         interpreter's, which read it.
     **kwargs
-        ``source``, ``units``, ``block_delete``, ``g28_reference_mm`` and ``g30_reference_mm``
+        ``source``, ``units``, ``block_delete``, ``tool_table`` (the machine's LinuxCNC tool
+        table: a :class:`~nctwin.machine.ToolTable`, such as a profile's, or a ``.tbl`` file's
+        path; default nctwin's own, tool 1 of size 0; the native reader takes the ``G43 H``
+        lengths from it), ``g28_reference_mm`` and ``g30_reference_mm``
         (the points G28 and G30 return to, LinuxCNC's parameters #5161-#5163 and #5181-#5183:
         X, Y, Z in mm in the Toolpath's coordinates, which a G92 offset does not move; default
         zero, as in LinuxCNC) for both readers; ``dwell_p_unit``, ``dialect`` (``"rs274ngc"``
         or ``"fanuc"``), ``start_mm``, ``arc_tol_mm``, ``arc_tol_rel`` for the native reader
         only (with ``reader="linuxcnc"`` only their defaults are allowed; with ``"auto"`` a
         non-default one, such as ``dialect="fanuc"``, keeps the program on the native reader);
-        ``tool_table``, ``max_moves``, ``timeout_s``, ``folder`` for the interpreter
-        only.
+        ``max_moves``, ``timeout_s``, ``folder`` for the interpreter only.
 
     Returns
     -------
@@ -91,10 +94,13 @@ def read(text: str, *, reader: str = "auto", **kwargs) -> ReadResult:
     GCodeError
         ``file:line: reason`` for a program that cannot be read.
     ValueError
-        For a bad ``reader`` or keyword argument, naming it, its value and what is allowed.
+        For a bad ``reader`` or keyword argument, naming it, its value and what is allowed;
+        ``file:line: reason`` for a tool table LinuxCNC would not read.
     """
     _check_reader(reader)
     check_dialect(kwargs.get("dialect", "rs274ngc"))
+    if "tool_table" in kwargs:
+        kwargs["tool_table"] = tool_table_of(kwargs["tool_table"], kwargs.get("source"))
     native = {k: v for k, v in kwargs.items() if k not in _LINUXCNC_ONLY}
     interp = {k: v for k, v in kwargs.items() if k not in _NATIVE_ONLY}
     changed = [k for k in _NATIVE_ONLY if k in kwargs and _differs(kwargs[k], k)]

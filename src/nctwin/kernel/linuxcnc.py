@@ -68,7 +68,7 @@ import numpy as np
 from ..checks import check_range
 from ..controls import PlannerControl
 from ..gcode import LINUXCNC_TOOL_TABLE, GCodeError, complete_tool_table, dump, parse
-from ..machine import Machine
+from ..machine import Machine, ToolTable
 from ..motion import Motion
 from ..toolpath import MotionKind, Toolpath
 
@@ -305,6 +305,7 @@ def record(
     *,
     timeout_s: float = 600.0,
     speed: float = 5,
+    tool_table: ToolTable | None = None,
 ) -> Recording:
     """Run a program on a fresh LinuxCNC instance and return what the sampler recorded.
 
@@ -321,6 +322,11 @@ def record(
     speed : float
         Speed-up over real time through libfaketime, in [1, 20]. Up to 5 the traces equal
         those of real time; faster shifts start-up and risks a starved planner queue.
+    tool_table : ToolTable, optional
+        The machine's tools (a profile's ``tool_table``), written to the instance's
+        ``tool.tbl``; default :data:`~nctwin.gcode.LINUXCNC_TOOL_TABLE`, tool 1 of size 0. The
+        program's other tools are added with size 0 where no size is needed
+        (:func:`~nctwin.gcode.complete_tool_table`).
 
     Raises
     ------
@@ -347,8 +353,10 @@ def record(
         files = {
             "sim.ini": ini,
             "sim.hal": hal_text(),
-            # the interpreter reader's default too: its tools and the program's others, of size 0
-            "tool.tbl": complete_tool_table(LINUXCNC_TOOL_TABLE, program),
+            # the machine's tools (or nctwin's own) and the program's others, of size 0
+            "tool.tbl": complete_tool_table(
+                LINUXCNC_TOOL_TABLE if tool_table is None else tool_table.text, program
+            ),
             "program.ngc": program,
             "display.py": _DISPLAY.read_text(),
         }
@@ -447,6 +455,7 @@ def run(
     *,
     timeout_s: float = 600.0,
     speed: float = 5,
+    tool_table: ToolTable | None = None,
 ) -> Motion:
     """Record a tool path (or program text) on LinuxCNC.
 
@@ -461,6 +470,8 @@ def run(
         Its period and blending tolerance too.
     timeout_s, speed : float
         See :func:`record`.
+    tool_table : ToolTable, optional
+        See :func:`record`; :func:`nctwin.gcode.parse` reads the text with it too.
 
     Returns
     -------
@@ -490,12 +501,12 @@ def run(
             "allowed a Toolpath or G-code text (str)"
         )
     _check_run_args(timeout_s, speed)
-    tp = parse(text)
+    tp = parse(text, tool_table=tool_table)
     if not ((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL)).any():
         # nothing moves: one sample at LinuxCNC's start position, without starting it
         z = np.zeros((1, 3))
         return Motion(np.zeros(1), z, z, np.zeros(1, dtype=np.int64), control.period_s)
-    rec = record(text, machine, control, timeout_s=timeout_s, speed=speed)
+    rec = record(text, machine, control, timeout_s=timeout_s, speed=speed, tool_table=tool_table)
     motion = motion_of(rec, tp)
     last = int(np.flatnonzero((tp.lengths_mm > 0) | (tp.kind == MotionKind.DWELL))[-1])
     if motion.block[-1] < last or not np.allclose(motion.pos_mm[-1], tp.end_mm[last], atol=1e-6):
