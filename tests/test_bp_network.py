@@ -137,7 +137,7 @@ def test_a_diverged_training_stops_at_its_first_nan_weight_and_is_cached(monkeyp
 
 @pytest.mark.parametrize("momentum", [0.0, 0.8])
 def test_the_loops_sgd_on_rows_is_torch_optim_sgd_on_windows_bit_for_bit(momentum) -> None:
-    """The loop's step (:class:`_SGD`, a batch's windows as one matrix of rows) and
+    """The loop's step (:class:`_SGD`, a batch's windows as one matrix of rows, a float mask) and
     ``torch.optim.SGD`` on the (windows, rows, n) batch, with the same dropout masks: the same
     losses and weights, bit for bit."""
     from nctwin.learn.train import _SGD, _autograd_step
@@ -155,11 +155,11 @@ def test_the_loops_sgd_on_rows_is_torch_optim_sgd_on_windows_bit_for_bit(momentu
             opt = torch.optim.SGD(net.parameters(), lr=0.05, momentum=momentum, foreach=True)
         with torch.random.fork_rng(devices=[]):
             torch.manual_seed(2)
-            losses = [
-                float(_autograd_step(net, opt, "mse", *(t[i].flatten(0, 1) if rows else t[i]
-                                                        for t in (x, y, mask))))
-                for i in range(len(x))
-            ]  # fmt: skip
+            batches = [(x[i], y[i], mask[i]) for i in range(len(x))]
+            if rows:  # as the loop runs them: rows, a float mask
+                batches = [(bx.flatten(0, 1), by.flatten(0, 1), bm.flatten(0, 1).float())
+                           for bx, by, bm in batches]  # fmt: skip
+            losses = [float(_autograd_step(net, opt, "mse", *b)) for b in batches]
         runs.append((losses, [p.detach().clone() for p in net.parameters()]))
     (ours, ours_w), (ref, ref_w) = runs
     assert ours == ref

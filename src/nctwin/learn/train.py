@@ -33,8 +33,9 @@ Steps
     :func:`torch.optim.sgd.sgd`, the update :class:`torch.optim.SGD` runs, called directly
     (:class:`_SGD`): the optimiser object's bookkeeping of a step (profiler scopes, hooks,
     parameter groups) cost a fifth of a BP network's step. The BP network's batches of windows
-    run as one (rows, n_inputs) matrix: the same products, without the autograd nodes that
-    reshape (windows, rows, n) inputs. Both give the same bits.
+    run as one (rows, n_inputs) matrix, masked by a float32 mask: the same products, without
+    the autograd nodes that reshape (windows, rows, n) inputs or the casts of a bool mask.
+    Both give the same bits.
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
@@ -397,7 +398,8 @@ class _AutogradRun:
         # a BP network maps rows: a batch of windows runs as one matrix of rows
         self.rows = isinstance(model, BPNetwork)
         if self.rows:
-            self.validation = tuple(t.flatten(0, 1) for t in self.validation)
+            x, y, mask = (t.flatten(0, 1) for t in self.validation)
+            self.validation = x, y, mask.to(torch.float32)
         if cfg.optimiser == "sgd":
             self.optimiser = _SGD(model.parameters(), cfg.learning_rate, cfg.momentum)
         else:
@@ -415,6 +417,8 @@ class _AutogradRun:
         chunk = cfg.batch_size * _BATCHES_PER_GATHER
         for c in range(0, len(windows), chunk):  # one gather for many batches
             xs, ys, ms = self.programs.batch(windows[c : c + chunk], cfg.window_lines)
+            if self.rows:
+                ms = ms.to(torch.float32)  # the bool mask's products, without a cast per step
             for b in range(0, len(xs), cfg.batch_size):
                 bx, by, bm = (t[b : b + cfg.batch_size] for t in (xs, ys, ms))
                 n_windows = len(bx)
