@@ -133,3 +133,37 @@ def test_a_diverged_training_stops_at_its_first_nan_weight_and_is_cached(monkeyp
     with pytest.raises(tr.TrainingDivergedError) as again:  # the divergence is cached
         fit(config, cfg, xs, ys, progress=False)
     assert str(again.value) == str(first.value)
+
+
+@pytest.mark.parametrize("momentum", [0.0, 0.8])
+def test_the_loops_sgd_on_rows_is_torch_optim_sgd_on_windows_bit_for_bit(momentum) -> None:
+    """The loop's step (:class:`_SGD`, a batch's windows as one matrix of rows, a float mask) and
+    ``torch.optim.SGD`` on the (windows, rows, n) batch, with the same dropout masks: the same
+    losses and weights, bit for bit."""
+    from nctwin.learn.train import _SGD, _autograd_step
+
+    config = BPConfig(n_inputs=6, hidden=(16, 8), dropout=0.5, weight_init="uniform")
+    g = torch.Generator().manual_seed(0)
+    x, y = torch.randn(6, 4, 3, 6, generator=g), torch.randn(6, 4, 3, 1, generator=g)
+    mask = torch.rand(6, 4, 3, 1, generator=g) > 0.2  # padded rows are masked out
+    runs = []
+    for rows in (True, False):
+        net = build_bp(config, generator=torch.Generator().manual_seed(1)).train()
+        if rows:
+            opt = _SGD(net.parameters(), 0.05, momentum)
+        else:
+            opt = torch.optim.SGD(net.parameters(), lr=0.05, momentum=momentum, foreach=True)
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(2)
+            batches = [(x[i], y[i], mask[i]) for i in range(len(x))]
+            if rows:  # as the loop runs them: rows, a float mask
+                batches = [(bx.flatten(0, 1), by.flatten(0, 1), bm.flatten(0, 1).float())
+                           for bx, by, bm in batches]  # fmt: skip
+            losses = [float(_autograd_step(net, opt, "mse", *b)) for b in batches]
+        runs.append((losses, [p.detach().clone() for p in net.parameters()]))
+    (ours, ours_w), (ref, ref_w) = runs
+    assert ours == ref
+    start = build_bp(config, generator=torch.Generator().manual_seed(1)).parameters()
+    for a, b, w0 in zip(ours_w, ref_w, start, strict=True):
+        assert torch.equal(a, b)
+        assert not torch.equal(a, w0)  # the steps moved every weight

@@ -175,22 +175,22 @@ def train_networks(
         return (fn, args)
 
     tasks = {}  # the slowest first: the runner hands tasks out in order
-    cfgs = paper_configs(n, seed=s0, dropout=0.0)
-    tasks["batch", None, 0.0] = task(_train_or_none, d1, train_rows, *cfgs, "zhang2023_batch0_p0")
     for s in seeds:
         tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, seed, s)
+    for batch, p in BATCH_RUNS:  # at 32 rows, 78,000 updates: next to the chains
+        if batch is not None:
+            cfgs = paper_configs(n, seed=s0, dropout=p, batch_rows=batch,
+                                 epochs=_batch_epochs(batch))  # fmt: skip
+            tasks["batch", batch, p] = task(_train_or_none, d1, train_rows, *cfgs,
+                                            f"zhang2023_batch{batch}_p{p:g}")  # fmt: skip
+    cfgs = paper_configs(n, seed=s0, dropout=0.0)
+    tasks["batch", None, 0.0] = task(_train_or_none, d1, train_rows, *cfgs, "zhang2023_batch0_p0")
     for s in seeds:
         tasks["paper", s] = task(_paper_chain, d1, train_rows, d2, data[3], seed, s)
     for s in seeds:
         cfgs = variant_configs(n, dropout=0.5, seed=s)
         tasks["dropout", s] = task(_train_or_none, d1, train_rows, *cfgs,
                                    f"zhang2023_variant_p0.5_seed{s}")  # fmt: skip
-    for batch, p in BATCH_RUNS:
-        if batch is not None:
-            cfgs = paper_configs(n, seed=s0, dropout=p, batch_rows=batch,
-                                 epochs=_batch_epochs(batch))  # fmt: skip
-            tasks["batch", batch, p] = task(_train_or_none, d1, train_rows, *cfgs,
-                                            f"zhang2023_batch{batch}_p{p:g}")  # fmt: skip
     for p in (p for p in probabilities if p not in (0.0, 0.5)):  # those: see ``same``
         cfgs = variant_configs(n, dropout=p, seed=s0)
         tasks["sweep", p] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_sweep_p{p:g}")
