@@ -95,3 +95,16 @@ def test_notebook_is_valid_nbformat(path):
     """nbconvert refuses an invalid notebook (a tag given twice is one), so the book would too."""
     nbformat = pytest.importorskip("nbformat")
     nbformat.validate(nbformat.read(path, as_version=4))
+
+
+EXECUTED = sorted((Path(__file__).resolve().parents[1] / "book" / "notebooks").glob("*.ipynb"))
+
+
+@pytest.mark.parametrize("path", EXECUTED, ids=lambda p: p.stem)
+def test_executed_notebook_shows_no_file_path(path):
+    # a cell ending in a writer's call displays the path it wrote: the machine's, not the book's
+    cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+    for i, cell in enumerate(cells):
+        for out in cell.get("outputs", []):
+            text = "".join(out.get("data", {}).get("text/plain", [])) + "".join(out.get("text", []))
+            assert "PosixPath(" not in text, f"{path.name}: cell {i} displays a file path"
