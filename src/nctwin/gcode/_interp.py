@@ -46,9 +46,9 @@ units, planes, offsets. Its canonical moves are turned into the same
   interpreter runs ``G64 P987654321 Q987654321``, a sentinel: a block in that state is in
   :attr:`~nctwin.toolpath.PathMode.DEFAULT` mode, as the native reader marks blocks before any
   G61/G64.
-* Splines: the module draws a G5 or G5.1 as straight lines, where LinuxCNC's task runs biarcs;
-  :mod:`nctwin.gcode._splines` puts the task's moves in their place (G5.2/G5.3 NURBS stay
-  the module's lines).
+* Splines: the module draws a G5 or G5.1 spline or a G5.2/G5.3 NURBS as straight lines, where
+  LinuxCNC's task runs biarcs; :mod:`nctwin.gcode._splines` puts the task's moves in their
+  place.
 * Canned cycles: LinuxCNC runs their moves in exact-path mode (but a first rapid up to R from
   below it); the module does not report that switch, so those blocks are marked here, as the
   native reader marks them.

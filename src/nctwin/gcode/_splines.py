@@ -1,4 +1,5 @@
-"""G5 and G5.1 splines as LinuxCNC's task runs them, not as its preview draws them.
+"""G5/G5.1 splines and G5.2/G5.3 NURBS as LinuxCNC's task runs them, not as its preview draws
+them.
 
 LinuxCNC 2.9's interpreter reads a spline (``Interp::convert_spline`` in interp_convert.cc) as
 the control points of a non-rational B-spline: G5.1 (quadratic) the current point, the point
@@ -21,6 +22,23 @@ k - 1 on u in [0, 1], which it passes to the canon's ``NURBS_FEED``. The two can
 (G5.1) or 60 (G5) straight feeds of one line that lie on one Bezier curve at the preview's u
 (the interpreter reports a spline line's motion mode as G1); it recovers the control points by
 least squares and puts the task's moves in their place.
+
+G5.2/G5.3 (``Interp::convert_nurbs``): the G5.2 lines collect control points X, Y with weights
+P (the first is the current point, weight 1, or P of a G5.2 without X and Y), L above 3 sets
+the order k (default 3); G5.3 passes them to the same ``NURBS_FEED``. With n + 1 points the
+knot vector of ``knot_vector_creator(n, k)`` is k zeros, 1 .. n - k + 1, then k times
+``umax = n - k + 2``, and u runs over [0, umax]; ``nurbs_point`` is the rational curve
+``sum N_i w_i P_i / sum N_i w_i`` (``Nmix``, ``Rden``). The preview draws ``15 (n + 1)`` lines
+at u accumulated in steps of ``umax / (15 (n + 1))``, the task ``4 (n + 1)`` biarcs at
+``u = umax i / (4 (n + 1))``, the tangents clipped at umax. :func:`task_splines` takes the
+preview's lines of a line whose state before is G5.2 (a G5.3 line), finds the n and k whose
+preview has that many lines, recovers the weights and control points as the null vector of a
+homogeneous least-squares fit (:func:`nurbs_fit`) and puts the task's biarcs in their place.
+Where no NURBS, or more than one, passes through the preview's points within
+:data:`FIT_TOL` (the control points lie on one line, say), the block is refused. (Source read:
+LinuxCNC at git f1270d6ed7, the commit of Debian's ``2.9.0~pre1`` package.) A live run of the
+language program ``nurbs`` in G61 passes within 6e-5 mm of every end of these biarcs (the
+trace's 1 ms chords; the preview's lines miss them by up to 0.018 mm).
 
 Straight splines (the control points on the chord) are the one case where this cannot follow
 LinuxCNC move for move. Their parts have parallel tangents, and ``biarc`` divides by
@@ -56,6 +74,13 @@ STRAIGHT_DEN = 1e-6
 PARALLEL_A = 1e-12
 #: Orders of the splines: G5.1 quadratic (3), G5 cubic (4).
 ORDERS = (3, 4)
+#: Lowest order of a G5.2 NURBS (``convert_nurbs`` starts at 3 and reads only L > 3).
+NURBS_MIN_ORDER = 3
+#: A NURBS fit is unique where its second-smallest singular value is above this share of the
+#: largest (the smallest is the curve's, 0 up to rounding).
+UNIQUE_SV = 1e-8
+#: The interpreter's motion mode (``gcodes[1]``) while G5.2 control points are read.
+G5_2_MODE = 52
 #: Farthest a preview point may lie from the fitted curve (inches): the preview's rounding.
 FIT_TOL = 1e-9
 _N_MOVE = 7
@@ -69,13 +94,17 @@ def bezier(u: np.ndarray, ctrl: np.ndarray) -> np.ndarray:
     return basis @ ctrl
 
 
-def preview_u(k: int) -> np.ndarray:
-    """The u of the preview module's points of a spline of order ``k`` (the last is the end)."""
-    step, u, out = 1.0 / (PREVIEW_DIV_PER_POINT * k), 0.0, []
-    while u + step < 1.0:  # as gcodemodule.cc accumulates it
+def preview_u(k: int, n: int | None = None) -> np.ndarray:
+    """The u of the preview module's points of a spline of order ``k`` and ``n + 1`` control
+    points (default n = k - 1, G5/G5.1): steps of ``umax / (15 (n + 1))`` accumulated while
+    below ``umax = n - k + 2``, then ``umax`` (the last control point)."""
+    n = k - 1 if n is None else n
+    umax = float(n - k + 2)
+    step, u, out = umax / (PREVIEW_DIV_PER_POINT * (n + 1)), 0.0, []
+    while u + step < umax:  # as gcodemodule.cc accumulates it
         out.append(u + step)
         u += step
-    return np.array([*out, 1.0])
+    return np.array([*out, umax])
 
 
 def control_points(points: np.ndarray, k: int) -> np.ndarray:
@@ -85,9 +114,51 @@ def control_points(points: np.ndarray, k: int) -> np.ndarray:
     return np.linalg.lstsq(basis, points, rcond=None)[0]
 
 
-def _knots(k: int) -> list[int]:
-    """``knot_vector_creator(n = k - 1, k)``: k zeros then k ones."""
-    return [0] * k + [1] * k
+def nurbs_fit(points: np.ndarray, n: int, k: int):
+    """The control points (n + 1, 2) and weights (n + 1,) of the NURBS of order ``k`` whose
+    preview points are ``points`` (m, 2), or None where no NURBS of that size and order passes
+    through them or more than one does.
+
+    Each point q at its u is a homogeneous linear equation in the weights w_i and the weighted
+    points w_i P_i: ``sum_i N_i(u) w_i (P_i - q) = 0``. Its least-squares null vector (SVD, the
+    points centred and scaled) gives them up to a common factor, which does not change the
+    curve; the weights are scaled to w_0 = 1.
+    """
+    u = preview_u(k, n)
+    if len(u) != len(points):
+        return None
+    basis = nurbs_basis(u, n, k)
+    centre = points.mean(axis=0)
+    size = max(float(np.abs(points - centre).max()), 1e-300)
+    q = (points - centre) / size
+    zero = np.zeros_like(basis)
+    a = np.block([[-basis * q[:, :1], basis, zero], [-basis * q[:, 1:], zero, basis]])
+    sv, vt = np.linalg.svd(a)[1:]
+    if sv[-2] <= UNIQUE_SV * sv[0]:
+        return None
+    v = vt[-1] if vt[-1, : n + 1].sum() > 0 else -vt[-1]
+    w = v[: n + 1]
+    if (w <= 0).any():
+        return None
+    ctrl = np.column_stack([v[n + 1 : 2 * n + 2] / w, v[2 * n + 2 :] / w]) * size + centre
+    return ctrl, w / w[0]
+
+
+def nurbs_sizes(m: int) -> list[tuple[int, int]]:
+    """The sizes (n, k) of the NURBS of which the preview draws ``m`` lines: n + 1 control
+    points, order k from 3 (``convert_nurbs`` reads L only above 3) to n + 1."""
+    return [
+        (n, k)
+        for n in range(max(2, m // PREVIEW_DIV_PER_POINT - 2), m // PREVIEW_DIV_PER_POINT + 1)
+        for k in range(NURBS_MIN_ORDER, n + 2)
+        if len(preview_u(k, n)) == m
+    ]
+
+
+def knot_vector(n: int, k: int) -> list[int]:
+    """``knot_vector_creator(n, k)`` (nurbs_additional_functions.cc): k zeros, the integers
+    1 .. n - k + 1, then k times ``umax = n - k + 2``; n + 1 control points of order k."""
+    return [0 if i < k else (i - k + 1 if i <= n else n - k + 2) for i in range(n + k + 1)]
 
 
 def _nmix(i: int, k: int, u: float, knots: list[int]) -> float:
@@ -106,36 +177,50 @@ def _nmix(i: int, k: int, u: float, knots: list[int]) -> float:
     ) / right
 
 
-def nurbs_points(u: np.ndarray, ctrl: np.ndarray) -> np.ndarray:
-    """``nurbs_point`` at each of ``u`` (m,) for control points ``ctrl`` (k, 2) of weight 1, in
+def nurbs_basis(u: np.ndarray, n: int, k: int) -> np.ndarray:
+    """``Nmix(i, k, u)`` for i = 0 .. n at each of ``u`` (m,): (m, n + 1)."""
+    knots = knot_vector(n, k)
+    return np.array([[_nmix(i, k, float(v), knots) for i in range(n + 1)] for v in u])
+
+
+def nurbs_points(u: np.ndarray, ctrl: np.ndarray, weights=None, k: int | None = None):
+    """``nurbs_point`` at each of ``u`` (m,) for control points ``ctrl`` (n + 1, 2) of weights
+    ``weights`` (n + 1,) (default 1) and order ``k`` (default n + 1, a Bezier curve), in
     LinuxCNC's order of operations (its rounding): (m, 2)."""
-    k = len(ctrl)
-    knots = _knots(k)
-    basis = np.array([[_nmix(i, k, float(v), knots) for i in range(k)] for v in u])
+    n = len(ctrl) - 1
+    k = n + 1 if k is None else k
+    w = np.ones(n + 1) if weights is None else np.asarray(weights, dtype=float)
+    basis = nurbs_basis(u, n, k)
     den = np.zeros(len(u))
-    for i in range(k):  # Rden
-        den = den + basis[:, i] * 1.0
+    for i in range(n + 1):  # Rden
+        den = den + basis[:, i] * w[i]
     out = np.zeros((len(u), 2))
-    for i in range(k):
-        out = out + ctrl[i] * basis[:, i, None] * 1.0 / den[:, None]
+    for i in range(n + 1):
+        out = out + ctrl[i] * basis[:, i, None] * w[i] / den[:, None]
     return out
 
 
-def task_moves(ctrl: np.ndarray, z: float) -> list[tuple]:
-    """The task canon's moves of a spline of control points ``ctrl`` (k, 2), program units, at
-    height ``z``: rows (kind 1 line or 2 arc, x, y, z, centre x, centre y, rotation +1 ccw or -1
-    cw), as the preview module reports moves.
+def task_moves(ctrl: np.ndarray, z: float, weights=None, k: int | None = None) -> list[tuple]:
+    """The task canon's moves (emccanon.cc ``NURBS_FEED``) of a NURBS of control points ``ctrl``
+    (n + 1, 2), program units, weights ``weights`` (n + 1,) (default 1) and order ``k`` (default
+    n + 1: G5/G5.1's Bezier curve) at height ``z``: rows (kind 1 line or 2 arc, x, y, z, centre
+    x, centre y, rotation +1 ccw or -1 cw), as the preview module reports moves.
 
     Raises
     ------
     ValueError
         If ``biarc`` finds no biarc for a part (LinuxCNC skips it).
     """
-    div = TASK_DIV_PER_POINT * len(ctrl)
-    u = np.arange(div + 1) / div
-    p = nurbs_points(u, ctrl)
-    lo, hi = np.maximum(0.0, u - TANGENT_DU), np.minimum(1.0, u + TANGENT_DU)
-    t = (nurbs_points(hi, ctrl) - nurbs_points(lo, ctrl)) / (hi - lo)[:, None]
+    n = len(ctrl) - 1
+    k = n + 1 if k is None else k
+    umax = float(n - k + 2)
+    div = TASK_DIV_PER_POINT * (n + 1)
+    u = umax * np.arange(div + 1) / div
+    p = nurbs_points(u, ctrl, weights, k)
+    lo, hi = np.maximum(0.0, u - TANGENT_DU), np.minimum(umax, u + TANGENT_DU)
+    t = (nurbs_points(hi, ctrl, weights, k) - nurbs_points(lo, ctrl, weights, k)) / (hi - lo)[
+        :, None
+    ]
     t = _unit(t)
     rows: list[tuple] = []
     for i in range(div):
@@ -187,7 +272,8 @@ def _arc(p0, p1, d, z) -> tuple:
 
 
 def task_splines(moves: np.ndarray, events: np.ndarray, modal: np.ndarray, source):
-    """The child's tables with every G5/G5.1 line's preview lines replaced by the task's moves.
+    """The child's tables with every G5/G5.1 and G5.3 line's preview lines replaced by the
+    task's moves.
 
     Parameters
     ----------
@@ -212,19 +298,22 @@ def task_splines(moves: np.ndarray, events: np.ndarray, modal: np.ndarray, sourc
     before = (events[:, 0] / _N_MOVE).astype(np.int64)
     ends = np.r_[before[1:], len(moves)]
     order = {len(preview_u(k)): k for k in ORDERS}
+    nurbs = events[:, 7] == G5_2_MODE  # a G5.3 line: its state before is G5.2's
     pieces, counts = [], np.ones(len(moves), dtype=np.int64)
-    for e in np.flatnonzero(np.isin(ends - before, list(order))):
+    for e in np.flatnonzero((np.isin(ends - before, list(order)) | nurbs) & (ends > before)):
         lo, hi = before[e], ends[e]
-        k = order[hi - lo]
         if (moves[lo:hi, 0] != 1).any():
             continue
         scale = MM_PER_INCH if after[e, 5] == 210 else 1.0  # program units, as the task's
         points = moves[lo:hi, 1:3] * scale
-        ctrl = control_points(points, k)
-        if np.abs(bezier(preview_u(k), ctrl) - points).max() > FIT_TOL * scale:
-            continue  # straight feeds of another kind (a subroutine's, say)
+        if nurbs[e]:
+            ctrl, weights, k = _nurbs_of(points, scale, int(events[e, 1]), source)
+        else:
+            ctrl, weights, k = control_points(points, order[hi - lo]), None, order[hi - lo]
+            if np.abs(bezier(preview_u(k), ctrl) - points).max() > FIT_TOL * scale:
+                continue  # straight feeds of another kind (a subroutine's, say)
         try:
-            rows = np.array(task_moves(ctrl, moves[lo, 3] * scale))
+            rows = np.array(task_moves(ctrl, moves[lo, 3] * scale, weights, k))
         except ValueError:
             raise GCodeError(
                 int(events[e, 1]), "", "LinuxCNC finds no biarc for a part of this spline and"
@@ -247,3 +336,22 @@ def task_splines(moves: np.ndarray, events: np.ndarray, modal: np.ndarray, sourc
     events[:, 0] = new_before[before] * _N_MOVE
     modal[:, 0] = new_before[(modal[:, 0] / _N_MOVE).astype(np.int64)] * _N_MOVE
     return np.vstack(out), events, modal
+
+
+def _nurbs_of(points: np.ndarray, scale: float, line: int, source):
+    """Control points (n + 1, 2), weights (n + 1,) and order of the one G5.2/G5.3 NURBS whose
+    preview points are ``points`` (m, 2), program units (``scale`` of an inch)."""
+    found = []
+    for n, k in nurbs_sizes(len(points)):
+        fit = nurbs_fit(points, n, k)
+        if fit is not None:
+            err = np.abs(nurbs_points(preview_u(k, n), fit[0], fit[1], k) - points).max()
+            if err <= FIT_TOL * scale:
+                found.append((*fit, k))
+    if len(found) != 1:
+        raise GCodeError(
+            line, "", "this NURBS's control points and weights cannot be told from LinuxCNC's"
+            " preview (no one NURBS fits its lines: control points on one line, say): not read",
+            source,
+        )  # fmt: skip
+    return found[0]

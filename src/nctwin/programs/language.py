@@ -1,7 +1,7 @@
 r"""Part programs in the whole RS274/NGC language, as a shop's CAM system or a programmer at the
 machine writes them: canned drilling cycles, cutter compensation, subroutines, parameters and
-expressions, offsets and units, arcs and helices outside the XY plane, splines, and the tool
-changes, pauses and dwells a control's task waits for.
+expressions, offsets and units, arcs and helices outside the XY plane, splines and NURBS, and
+the tool changes, pauses and dwells a control's task waits for.
 
 Paper 1's training programs and the CAM-style programs (:mod:`nctwin.programs.training`,
 :mod:`nctwin.programs.camstyle`) are chains of G1 lines that the native reader reads. A shop's
@@ -372,6 +372,48 @@ M2
 """
 
 
+def nurbs() -> str:
+    """G5.2/G5.3 NURBS in the XY plane at 20-40 mm/s, which LinuxCNC's task runs as biarcs: a
+    quadratic wave of weights 1 (order 3, the default), a quarter circle of radius 30 mm (a
+    rational quadratic, its middle weight sqrt(2)/2), a cubic (L4) and a quartic (L5) of
+    weights 0.5-4."""
+    return """\
+(nctwin language program: G5.2/G5.3 NURBS)
+G21 G17 G90 G94 G40 G49 G80
+G64 P0.02
+G0 X0 Y0 Z1
+G1 Z0 F600
+(a quadratic wave, order 3, weights 1, at 20 mm/s)
+G5.2 X10 Y20 P1 F1200
+X30 Y-20 P1
+X50 Y20 P1
+X60 Y0 P1
+G5.3
+G1 X90 Y0
+(a quarter circle of radius 30 mm about X60 Y0: the middle weight is cos 45 deg)
+G5.2 X90 Y30 P0.7071067811865476
+X60 Y30 P1
+G5.3
+(a cubic, L4, weights 1 to 4, at 40 mm/s)
+G5.2 X40 Y50 P1 L4 F2400
+X20 Y30 P4
+X0 Y60 P1
+X-20 Y40 P2
+X-10 Y20 P1
+G5.3
+(a quartic, L5, at 30 mm/s)
+G5.2 X-30 Y10 P1 L5 F1800
+X-20 Y-20 P3
+X0 Y-30 P0.5
+X20 Y-20 P2
+X10 Y-5 P1
+G5.3
+G1 X0 Y0
+G0 Z5
+M2
+"""
+
+
 def tool_pauses() -> str:
     """Words LinuxCNC's task runs only once the motion has stopped, between moves: coolant on
     and off, a program pause (M0), the spindle stopped and started, a tool change with its
@@ -420,5 +462,6 @@ LANGUAGE_PROGRAMS: dict[str, Callable[[], str]] = {
     "offsets_units": offsets_units,
     "plane_arcs": plane_arcs,
     "splines": splines,
+    "nurbs": nurbs,
     "tool_pauses": tool_pauses,
 }
