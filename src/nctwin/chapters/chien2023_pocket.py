@@ -90,7 +90,8 @@ def _with(spec: PaperPocket, **changes: float) -> PaperPocket:
 
 def _smallest_scale(band_mm: float) -> float:
     """The smallest ``outline_scale`` (5 decimals) whose island stands at ``band_mm``."""
-    return math.ceil(1e5 * band_mm / BAND_MAX_PER_SCALE_MM) / 1e5
+    scale = math.ceil(1e5 * band_mm / BAND_MAX_PER_SCALE_MM) / 1e5
+    return scale if BAND_MAX_PER_SCALE_MM * scale >= band_mm else scale + 1e-5  # rounding
 
 
 def _widest_band(targets: dict[str, float], stepover_mm: float) -> float:
