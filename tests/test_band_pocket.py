@@ -166,3 +166,15 @@ def test_calibration_targets_are_the_papers_statistics():
     assert (targets["path_m_min"], targets["path_m_max"]) == (implied_m.min(), implied_m.max())
     summary = load_paper_table("chien2023_summary").set_index("quantity")
     assert targets["lines"] == summary.value["pocketing_glines"]
+
+
+@pytest.mark.parametrize("band_mm", [20.233, 50.072, 70.993])
+def test_the_smallest_scale_holds_its_band(band_mm):
+    # 44 mm of band per unit of scale: 50.072 / 44 = 1.138 exactly, but 44 * 1.138 falls 4e-15
+    # short in floating point; the scale a band gets must hold it, and one step less must not
+    from nctwin.chapters.chien2023_pocket import _smallest_scale
+
+    scale = _smallest_scale(band_mm)
+    assert bp.BAND_MAX_PER_SCALE_MM * scale >= band_mm
+    assert bp.BAND_MAX_PER_SCALE_MM * (scale - 1e-5) < band_mm
+    bp.PaperPocket(outline_scale=scale, band_mm=band_mm, chord_tol_mm=1e-4)  # accepted

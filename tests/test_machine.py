@@ -216,7 +216,7 @@ def test_toml_errors(tmp_path):
 def test_a_method_needs_its_control():
     p = load_profile("paper1_sim")
     assert p.control_for("cam") is None
-    assert p.control_for("kernel") == FirControl(blend_tol_mm=0.4, t1_s=0.08, t2_s=0.02)
+    assert p.control_for("kernel") == FirControl(blend_tol_mm=0.4, t1_s=0.16, t2_s=0.02)
     with pytest.raises(
         ValueError,
         match=r"method 'planner' needs a control: .*paper1_sim has no "

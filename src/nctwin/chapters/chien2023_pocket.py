@@ -90,7 +90,8 @@ def _with(spec: PaperPocket, **changes: float) -> PaperPocket:
 
 def _smallest_scale(band_mm: float) -> float:
     """The smallest ``outline_scale`` (5 decimals) whose island stands at ``band_mm``."""
-    return math.ceil(1e5 * band_mm / BAND_MAX_PER_SCALE_MM) / 1e5
+    scale = math.ceil(1e5 * band_mm / BAND_MAX_PER_SCALE_MM) / 1e5
+    return scale if BAND_MAX_PER_SCALE_MM * scale >= band_mm else scale + 1e-5  # rounding
 
 
 def _widest_band(targets: dict[str, float], stepover_mm: float) -> float:
@@ -114,9 +115,9 @@ def _solve_geometry(
     """``outline_scale`` for the path and (unless given) ``chord_tol_mm`` for the G-lines at
     ``band_mm`` and ``stepover_mm``; the two are solved in turn twice (the chords change the path
     a little)."""
-    spec = PaperPocket(outline_scale=1.0, band_mm=band_mm, chord_tol_mm=chord_tol_mm or 1e-4,
-                       stepover_mm=stepover_mm)  # fmt: skip
     low_scale = _smallest_scale(band_mm)
+    spec = PaperPocket(outline_scale=max(1.0, low_scale), band_mm=band_mm,
+                       chord_tol_mm=chord_tol_mm or 1e-4, stepover_mm=stepover_mm)  # fmt: skip
     for _ in range(2):
         scale = _bisect(lambda s, spec=spec: _stats(_with(spec, outline_scale=s))["path_m"]
                         - targets["path_m"], low_scale, 5.0, 20)  # fmt: skip

@@ -316,14 +316,14 @@ def band_pocket_program(spec: PaperPocket, *, feed_mm_s: float, tol_mm: float | 
                          "then a finishing ring along each wall")  # fmt: skip
 
 
-#: Table 2's pocket, solved on ``paper1_sim`` (the FIR kernel, unrecorded): the scale for 12.41 m
+#: Table 2's pocket, solved on ``paper1_sim`` (the FIR kernel, unrecorded): the scale for 12.42 m
 #: of path (the mean of the 11.5-13.1 m that Table 2's CAM times imply), the chordal tolerance
-#: for 4999 G-lines (the paper: 5000) and the band for CAM's error (ours 32-44 % on the four
-#: rows, the paper's 35-41 %; mean difference 0).
-TABLE2 = PaperPocket(outline_scale=1.9404, band_mm=20.233, chord_tol_mm=5.35e-05)
+#: for 5000 G-lines (the paper: 5000) and the band for CAM's error (ours 37.2, 33.6, 42.9 and
+#: 39.3 % at 75 and 92 mm/s by 0.3 and 0.4 mm, the paper's 36, 35, 41, 41 %; mean difference 0).
+TABLE2 = PaperPocket(outline_scale=0.9269, band_mm=39.379, chord_tol_mm=2.02e-05)
 #: Table 3's pocket, solved on ``paper1_machine_b`` recorded through its position loop: the
 #: scale for 4.41 m of path (the paper's CAM times imply 4.34-4.48 m, mean 4.41 m) and Table 2's
-#: chordal tolerance (the same post-processor; 2851 G-lines). At Table 2's 2 mm stepover even the
+#: chordal tolerance (the same post-processor; 4508 G-lines). At Table 2's 2 mm stepover even the
 #: widest band a part of this path allows (the island's chamfer collapsed, ``band_mm`` =
 #: ``BAND_MAX_PER_SCALE_MM`` ``outline_scale``: 24.9 mm, rows of 17 mm, two 90-degree corners
 #: every 19 mm of zig-zag) leaves CAM 25-30 % short on the four rows (mean 27.7 %; the paper's
@@ -332,10 +332,11 @@ TABLE2 = PaperPocket(outline_scale=1.9404, band_mm=20.233, chord_tol_mm=5.35e-05
 #: rows, so the same 4.41 m belongs to a larger part with a wider band: CAM's mean error falls to
 #: 24.8 % at 4 mm, 18.5 % at 6 mm and 16.5 % at the tool's diameter, 8 mm, the widest a zig-zag
 #: leaves no ridges at (band 40.7 mm, rows of 33 mm, two corners every 41 mm). The solver stops
-#: there, the closest this tool comes: CAM's error 15.9, 14.5, 18.5 and 17.0 % (measured/CAM
-#: 1.19, 1.17, 1.23, 1.20; the paper's 14, 13, 13, 12 %, 1.16, 1.15, 1.17, 1.13), the rows at
-#: 70 mm/s within 2 points, those at 80 mm/s not: ours rises by 2.5 points from 70 to 80 mm/s
-#: where the paper's falls by one, a property of machine B's corners, not of the path.
+#: there, the closest this tool comes: CAM's error 16.1, 14.6, 18.6 and 17.2 % (measured/CAM
+#: 1.19, 1.17, 1.23, 1.21; the paper's 14, 13, 13, 12 %, 1.16, 1.15, 1.17, 1.13), the rows at
+#: 70 mm/s within about 2 points (2.07 at 0.075 mm), those at 80 mm/s not: ours rises by 2.5
+#: points from 70 to 80 mm/s where the paper's falls by one, a property of machine B's corners,
+#: not of the path.
 TABLE3 = PaperPocket(
     outline_scale=0.9253, band_mm=40.712, chord_tol_mm=TABLE2.chord_tol_mm, stepover_mm=8.0
 )
