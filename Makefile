@@ -342,7 +342,10 @@ browser: book chromium
 bench: venv
 	@shopt -s nullglob; scripts=(benchmarks/[!_]*.py); \
 	if [ $${#scripts[@]} -eq 0 ]; then echo "bench: benchmarks/ holds no script" >&2; exit 0; fi; \
-	for s in "$${scripts[@]}"; do echo "bench: $$s" >&2; $(PY) "$$s"; done
+	set -o pipefail; status=0; \
+	for s in "$${scripts[@]}"; do echo "bench: $$s" >&2; \
+	  $(PY) "$$s" | $(PY) benchmarks/_targets.py || { echo "bench: $$s FAILED" >&2; status=1; }; \
+	done; exit $$status
 
 # ---------------------------------------------------------------------------------------------
 clean:

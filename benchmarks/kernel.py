@@ -1,7 +1,9 @@
 """FIR kernel throughput: the 5000-line pocket (about 220 s of motion at 1 ms) and the
 10,000-line ``contour.ngc``.
 
-Targets: at least 10 million output samples per second; the pocket in under 0.3 s. The
+Targets: at least 10 million output samples per second where samples decide the time; the
+pocket in under 0.3 s; ``contour.ngc`` at 100,000 blocks per second or more (the planner's
+target, 0.1 s per 10,000 blocks), since its blocks, not its samples, decide its time. The
 throughput is end to end: output samples over the wall time of
 ``fir.run(toolpath, machine, settings)``
 (planning included), best of 5, each run on a fresh copy of the parsed tool path so that no
@@ -68,15 +70,15 @@ def main() -> None:
         tp = parse_file(contour)
         n = len(fir.run(tp, machine, settings))
         tc = cold_time_s(lambda tp: fir.run(tp, machine, settings), tp)
-        record("kernel_contour_samples_per_s", round(n / tc), "samples/s", ">= 1e7")
-        record("kernel_contour_blocks_per_s", round(len(tp) / tc), "blocks/s", "")
+        record("kernel_contour_samples_per_s", round(n / tc), "samples/s", "")
+        record("kernel_contour_blocks_per_s", round(len(tp) / tc), "blocks/s", ">= 1e5")
         total_samples += n
         total_time += tc
     else:
         print(f"kernel: {contour} not found, skipped", file=sys.stderr)
     record("kernel_samples_per_s", round(total_samples / total_time), "samples/s", ">= 1e7")
     record("kernel_pocket5000_lines", len(pocket), "G-lines", "~5000")
-    record("kernel_pocket5000_motion_s", samples * machine.period_s, "s", "~220")
+    record("kernel_pocket5000_motion_s", samples * settings.period_s, "s", "~220")
 
 
 if __name__ == "__main__":
