@@ -161,13 +161,14 @@ def test_parallel_training_gives_the_sequential_bits(tmp_path, monkeypatch) -> N
 
     monkeypatch.setenv("NCTWIN_CACHE", str(tmp_path / "sequential"))
     data, rows = _tiny_surface(0), np.arange(400)
-    args = [(data, rows, *zh.variant_configs(7, max_epochs=3, seed=s), f"tiny{s}") for s in (0, 1)]
-    one = [zs._train_or_none(*a) for a in args]
+    args = [(data, rows, [zh.variant_configs(7, max_epochs=3, seed=s)], [f"tiny{s}"])
+            for s in (0, 1)]  # fmt: skip
+    one = [zs._stack(*a)[0] for a in args]
     # fresh workers that see a fresh cache: the networks are trained there, not loaded
     get_reusable_executor().shutdown(wait=True)
     monkeypatch.setenv("NCTWIN_CACHE", str(tmp_path / "parallel"))
     try:
-        two = run_tasks(zs._call, [(zs._train_or_none, a) for a in args], n_jobs=2)
+        two = [r[0] for r in run_tasks(zs._call, [(zs._stack, a) for a in args], n_jobs=2)]
     finally:
         get_reusable_executor().shutdown(wait=True)
     assert len(list((tmp_path / "parallel").rglob("*.pt"))) == 2

@@ -7,7 +7,8 @@ segment (:func:`nctwin.physics.steperror.step_error_um`, the network's target) a
 samples (:func:`nctwin.physics.steperror.step_error_samples`, with the number of inner points
 that makes the input width fit eq. 8 with the paper's first hidden layer).
 
-Training runs through the shared loop :func:`nctwin.learn.train.fit`, which learns on "programs" of
+Training runs through the shared loop of :mod:`nctwin.learn.train`, several networks of one
+shape at a time (:func:`nctwin.learn.stack.fit_stack`); the loop learns on "programs" of
 consecutive rows. Samples are independent, so the training rows are cut, in a seeded random
 order, into chunks of ``window_lines`` rows; a batch is ``batch_size`` chunks, and the loop holds
 out ``val_share`` of the chunks (10 %) to keep the weights of the best validation epoch. Inputs
@@ -45,6 +46,7 @@ Every network of the chapter is trained by :func:`nctwin.chapters.zhang2023_seed
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 
@@ -54,7 +56,8 @@ import torch
 
 from ..checks import best_time_s
 from ..learn.models import BPConfig
-from ..learn.train import TrainConfig, Trained, fit, load_checkpoint
+from ..learn.stack import fit_stack
+from ..learn.train import TrainConfig, Trained, TrainingDivergedError, load_checkpoint
 from ..physics.steperror import step_error_iterative_um, step_error_samples, step_error_um
 from ..report.papers import load_paper_table
 from .zhang2023_surfaces import (
@@ -231,34 +234,41 @@ def finetune_configs(n_inputs: int, *, seed: int = 0) -> tuple[BPConfig, TrainCo
 def train(
     data: SurfaceData,
     rows: np.ndarray,
-    model_config: BPConfig,
-    train_config: TrainConfig,
+    model_configs: Sequence[BPConfig],
+    train_configs: Sequence[TrainConfig],
     *,
-    name: str,
-    init: Trained | None = None,
-    progress: bool = True,
-) -> Trained:
-    """Train (or fine-tune from ``init``) on the rows ``rows`` of ``data`` with the shared loop.
+    names: Sequence[str],
+    init: Sequence[Trained] | None = None,
+) -> list[Trained | None]:
+    """Train (or fine-tune from ``init``) one network per config on the rows ``rows`` of
+    ``data``, as one stack (:func:`nctwin.learn.stack.fit_stack`: the configs may differ in the
+    seed and the dropout only).
 
-    The rows, in the given order, are cut into chunks of ``train_config.window_lines``.
+    The rows, in the given order, are cut into chunks of ``window_lines``.
+
+    Returns
+    -------
+    list of Trained or None
+        One per config; None where the training diverged.
 
     Raises
     ------
     ValueError
         If fewer than two chunks result (the loop needs one to validate on).
     """
+    window = train_configs[0].window_lines
     x, y = data.x[rows], data.y_um[rows]
-    n_chunks = -(-len(rows) // train_config.window_lines)
+    n_chunks = -(-len(rows) // window)
     if n_chunks < 2:
         raise ValueError(
-            f"rows = {len(rows)} is out of range: allowed at least "
-            f"{train_config.window_lines + 1} (two chunks)"
+            f"rows = {len(rows)} is out of range: allowed at least {window + 1} (two chunks)"
         )
     if n_chunks < 20:  # small fine-tuning sets: smaller chunks, so that 10 % can validate
-        train_config = replace(train_config, window_lines=max(1, len(rows) // 20))
-    xs = np.array_split(x, -(-len(rows) // train_config.window_lines))
+        window = max(1, len(rows) // 20)
+        train_configs = [replace(c, window_lines=window) for c in train_configs]
+    xs = np.array_split(x, -(-len(rows) // window))
     ys = np.array_split(y, len(xs))
-    return fit(model_config, train_config, xs, ys, name=name, init=init, progress=progress)
+    return fit_stack(model_configs, train_configs, xs, ys, names=names, init=init)
 
 
 def predict_um(trained: Trained, x: np.ndarray) -> np.ndarray:
@@ -412,33 +422,45 @@ class TransferRun:
 
 
 def transfer(
-    start: Trained,
+    starts: Sequence[Trained],
     data: SurfaceData,
     shares_pct: tuple[float, ...],
-    train_config: TrainConfig,
+    train_configs: Sequence[TrainConfig],
     *,
     seed: int,
-    progress: bool = True,
     prefix: str = "zhang2023",
-) -> list[TransferRun]:
-    """Fine-tune ``start`` on ``shares_pct`` % of the samples of ``data`` and predict the rest
-    (Tables 4-7); 0 % predicts every sample with ``start`` unchanged.
+) -> list[list[TransferRun]]:
+    """Fine-tune each of ``starts`` on ``shares_pct`` % of the samples of ``data`` and predict
+    the rest (Tables 4-7); 0 % predicts every sample with the start network unchanged.
 
-    Each share draws its rows with :func:`split` (seed ``seed``); the fine-tuning keeps the
-    start network's scalers. ``prefix`` begins the checkpoints' names.
+    Each share draws its rows with :func:`split` (seed ``seed``, the same rows for every start)
+    and fine-tunes the starts as one stack (:func:`train`; ``train_configs``: one per start);
+    each keeps its start network's scalers. ``prefix`` begins the checkpoints' names.
+
+    Returns
+    -------
+    list of list of TransferRun
+        One list per start, one run per share.
+
+    Raises
+    ------
+    TrainingDivergedError
+        If a fine-tuning diverged.
     """
-    runs = []
+    runs: list[list[TransferRun]] = [[] for _ in starts]
     for pct in shares_pct:
         picked, rest = split(len(data.x), pct / 100.0, seed=seed)
+        tuned: list[Trained | None] = list(starts)
         if len(picked):
-            name = f"{prefix}_s{data.index}_ft{pct:g}_seed{train_config.seed}"
-            tuned = train(
-                data, picked, start.model.config, train_config, name=name, init=start,
-                progress=progress,
-            )  # fmt: skip
-        else:
-            tuned = start
-        runs.append(TransferRun(data.index, pct, tuned, rest, predict_um(tuned, data.x[rest])))
+            names = [f"{prefix}_s{data.index}_ft{pct:g}_seed{c.seed}" for c in train_configs]
+            tuned = train(data, picked, [s.model.config for s in starts], train_configs,
+                          names=names, init=starts)  # fmt: skip
+        for chain, net, name in zip(runs, tuned, [s.path.stem for s in starts], strict=True):
+            if net is None:
+                raise TrainingDivergedError(
+                    f"fine-tuning {name} on {pct:g} % of surface {data.index} diverged"
+                )
+            chain.append(TransferRun(data.index, pct, net, rest, predict_um(net, data.x[rest])))
     return runs
 
 

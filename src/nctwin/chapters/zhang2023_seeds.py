@@ -1,8 +1,11 @@
-"""The Zhang chapter's networks, trained in one pool of parallel tasks, and their ensembles.
+"""The Zhang chapter's networks, trained as stacks in parallel tasks, and their ensembles.
 
-:func:`train_networks` trains every network of the chapter through
-:func:`nctwin.runner.run_tasks` (one task per network, or per chain of networks that start from
-one another; one torch thread each, so the weights do not depend on the worker or the order):
+:func:`train_networks` trains every network of the chapter as stacks
+(:func:`nctwin.learn.stack.fit_stack`: networks that differ in seed or dropout only, stepped
+together; each trains as it would alone) through :func:`nctwin.runner.run_tasks`, in three
+rounds: surface 1 (one stack per setting, with the paper's short fine-tuning chains), then the
+variant's fine-tuning to surface 2 (one stack per share), then to surface 3. One torch thread
+each, so the weights do not depend on the worker or the order. The networks:
 
 * the networks the claims judge, once per seed: the paper's settings (full batch, dropout 0.5)
   and its fine-tuning chain to surfaces 2 and 3 at 15 % with the same settings (the paper gives
@@ -100,41 +103,57 @@ class Networks:
     scratch: Trained
 
 
-def _train_or_none(data, rows, model_config, train_config, name) -> Trained | None:
-    try:
-        return train(data, rows, model_config, train_config, name=name, progress=False)
-    except TrainingDivergedError:
-        return None
+def _stack(data, rows, cfgs, names) -> list[Trained | None]:
+    """Train the networks of ``cfgs`` ((model, train) config pairs) as one stack."""
+    return train(data, rows, [c[0] for c in cfgs], [c[1] for c in cfgs], names=names)
 
 
-def _chain(d1, train_rows, d2, d3, shares, seed, train_seed):
-    """The variant without dropout (seed ``train_seed``) and its fine-tuning chains."""
+def _paper(d1, train_rows, d2, d3, seed, seeds):
+    """The paper's settings, one per seed, with their fine-tuning chains at 0 and 15 % with the
+    same settings (empty where surface 1's training diverged), and the paper's settings without
+    dropout (the chapter's seed), trained in the same stack."""
     n = d1.x.shape[1]
-    model_cfg, train_cfg = variant_configs(n, dropout=0.0, seed=train_seed)
-    name = f"zhang2023_variant_p0_seed{train_seed}"
-    net1 = train(d1, train_rows, model_cfg, train_cfg, name=name, progress=False)
-    _, ft = finetune_configs(n, seed=train_seed)
-    runs2 = transfer(net1, d2, shares, ft, seed=seed, progress=False)
-    runs3 = transfer(runs2[-1].trained, d3, shares, ft, seed=seed, progress=False)
-    return net1, runs2, runs3
+    cfgs = [paper_configs(n, seed=s) for s in seeds] + [
+        paper_configs(n, seed=seeds[0], dropout=0.0)
+    ]
+    names = [f"zhang2023_paper_seed{s}" for s in seeds] + ["zhang2023_batch0_p0"]
+    *nets, no_dropout = _stack(d1, train_rows, cfgs, names)
+    kept = [k for k, net in enumerate(nets) if net is not None]
+    chains2, chains3 = [[] for _ in seeds], [[] for _ in seeds]
+    if kept:
+        ft, prefix = [cfgs[k][1] for k in kept], "zhang2023_paper"
+        runs2 = transfer([nets[k] for k in kept], d2, (0.0, 15.0), ft, seed=seed, prefix=prefix)
+        runs3 = transfer([r[-1].trained for r in runs2], d3, (0.0, 15.0), ft, seed=seed,
+                         prefix=prefix)  # fmt: skip
+        for k, r2, r3 in zip(kept, runs2, runs3, strict=True):
+            chains2[k], chains3[k] = r2, r3
+    return nets, no_dropout, chains2, chains3
 
 
-def _paper_chain(d1, train_rows, d2, d3, seed, train_seed):
-    """The paper's settings (seed ``train_seed``) and their fine-tuning chain at 0 and 15 %,
-    with the same settings; None and empty chains if surface 1's training diverged."""
-    cfgs = paper_configs(d1.x.shape[1], seed=train_seed)
-    net1 = _train_or_none(d1, train_rows, *cfgs, f"zhang2023_paper_seed{train_seed}")
-    if net1 is None:
-        return None, [], []
-    shares, name = (0.0, 15.0), "zhang2023_paper"
-    runs2 = transfer(net1, d2, shares, cfgs[1], seed=seed, progress=False, prefix=name)
-    runs3 = transfer(runs2[-1].trained, d3, shares, cfgs[1], seed=seed, progress=False,
-                     prefix=name)  # fmt: skip
-    return net1, runs2, runs3
+def _transfer(starts, data, pct, train_configs, seed) -> list[TransferRun]:
+    """Each of ``starts`` fine-tuned on ``pct`` % of ``data`` (one stack)."""
+    return [chain[0] for chain in transfer(starts, data, (pct,), train_configs, seed=seed)]
+
+
+def _chains(starts, data, shares, train_configs, seed, n_jobs) -> list[list[TransferRun]]:
+    """:func:`transfer` of ``starts`` at every share, one stack per share in parallel (the
+    largest share first); one list of runs per start, in the order of ``shares``."""
+    tasks = {p: (_transfer, starts, data, p, train_configs, seed)
+             for p in sorted(shares, reverse=True) if p > 0}  # fmt: skip
+    runs = _run(tasks, n_jobs)
+    runs.update({p: _transfer(starts, data, p, train_configs, seed) for p in shares if p == 0})
+    return [list(chain) for chain in zip(*(runs[p] for p in shares), strict=True)]
 
 
 def _call(fn: Callable, args: tuple):
     return fn(*args)
+
+
+def _run(tasks: dict, n_jobs: int) -> dict:
+    """Run ``tasks`` (key -> (function, *args)) in parallel, in their order (the runner hands
+    them out in order: the slowest first)."""
+    calls = [(t[0], t[1:]) for t in tasks.values()]
+    return dict(zip(tasks, run_tasks(_call, calls, n_jobs=n_jobs), strict=True))
 
 
 def train_networks(
@@ -147,7 +166,8 @@ def train_networks(
     seed: int,
     n_jobs: int = 2,
 ) -> Networks:
-    """Train every network of the chapter (see the module docstring), ``n_jobs`` at a time.
+    """Train every network of the chapter (see the module docstring), ``n_jobs`` stacks at a
+    time.
 
     Parameters
     ----------
@@ -161,61 +181,68 @@ def train_networks(
     probabilities : sequence of float
         The dropout sweep's drop probabilities.
     shares : tuple of float
-        Fine-tuning shares (%), increasing, the last 15.
+        Fine-tuning shares (%), increasing, the first 0, the last 15.
     seed : int
         Seed of the data splits.
     n_jobs : int
-        Parallel trainings.
+        Parallel stacks.
     """
-    d1, d2 = data[1], data[2]
+    d1, d2, d3 = data[1], data[2], data[3]
     n = d1.x.shape[1]
+    seeds = list(seeds)
     s0 = seeds[0]
-
-    def task(fn, *args):
-        return (fn, args)
-
-    tasks = {}  # the slowest first: the runner hands tasks out in order
-    for s in seeds:
-        tasks["chain", s] = task(_chain, d1, train_rows, d2, data[3], shares, seed, s)
-    for batch, p in BATCH_RUNS:  # at 32 rows, 78,000 updates: next to the chains
-        if batch is not None:
-            cfgs = paper_configs(n, seed=s0, dropout=p, batch_rows=batch,
-                                 epochs=_batch_epochs(batch))  # fmt: skip
-            tasks["batch", batch, p] = task(_train_or_none, d1, train_rows, *cfgs,
-                                            f"zhang2023_batch{batch}_p{p:g}")  # fmt: skip
-    cfgs = paper_configs(n, seed=s0, dropout=0.0)
-    tasks["batch", None, 0.0] = task(_train_or_none, d1, train_rows, *cfgs, "zhang2023_batch0_p0")
-    for s in seeds:
-        tasks["paper", s] = task(_paper_chain, d1, train_rows, d2, data[3], seed, s)
-    for s in seeds:
-        cfgs = variant_configs(n, dropout=0.5, seed=s)
-        tasks["dropout", s] = task(_train_or_none, d1, train_rows, *cfgs,
-                                   f"zhang2023_variant_p0.5_seed{s}")  # fmt: skip
-    for p in (p for p in probabilities if p not in (0.0, 0.5)):  # those: see ``same``
-        cfgs = variant_configs(n, dropout=p, seed=s0)
-        tasks["sweep", p] = task(_train_or_none, d1, train_rows, *cfgs, f"zhang2023_sweep_p{p:g}")
+    sweep_ps = [p for p in probabilities if p not in (0.0, 0.5)]  # those: ``variant``, ``dropout``
+    variant = [variant_configs(n, dropout=0.0, seed=s) for s in seeds]
+    dropout = [variant_configs(n, dropout=p, seed=s) for p, s in
+               [(0.5, s) for s in seeds] + [(p, s0) for p in sweep_ps]]  # fmt: skip
     picked2, _ = split(len(d2.x), 0.15, seed=seed)
-    cfgs = variant_configs(n, seed=s0)
-    tasks["scratch"] = task(_train_or_none, d2, picked2, *cfgs, "zhang2023_s2_scratch15")
-    out = dict(zip(tasks, run_tasks(_call, tasks.values(), n_jobs=n_jobs), strict=True))
-    chains = [out["chain", s] for s in seeds]
-    papers = [out["paper", s] for s in seeds]
-    same = {0.0: chains[0][0], 0.5: out["dropout", s0]}  # the sweep's runs trained already
+    # surface 1, the slowest stacks first
+    tasks = {
+        "variant": (_stack, d1, train_rows, variant,
+                    [f"zhang2023_variant_p0_seed{s}" for s in seeds]),
+        "dropout": (_stack, d1, train_rows, dropout,
+                    [f"zhang2023_variant_p0.5_seed{s}" for s in seeds]
+                    + [f"zhang2023_sweep_p{p:g}" for p in sweep_ps]),
+        "paper": (_paper, d1, train_rows, d2, d3, seed, seeds),
+    }  # fmt: skip
+    by_batch = {}  # rows per update -> dropout probabilities (the full batch: ``_paper``)
+    for b, p in BATCH_RUNS:
+        if b is not None:
+            by_batch.setdefault(b, []).append(p)
+    for batch, ps in by_batch.items():
+        cfgs = [paper_configs(n, seed=s0, dropout=p, batch_rows=batch, epochs=_batch_epochs(batch))
+                for p in ps]  # fmt: skip
+        tasks["batch", batch] = (_stack, d1, train_rows, cfgs,
+                                 [f"zhang2023_batch{batch}_p{p:g}" for p in ps])  # fmt: skip
+    tasks["scratch"] = (_stack, d2, picked2, [variant_configs(n, seed=s0)],
+                        ["zhang2023_s2_scratch15"])  # fmt: skip
+    out = _run(tasks, n_jobs)
+    # the variant's fine-tuning: surface 2 at each share, then surface 3 from its 15 % networks
+    nets1 = out["variant"]
+    if None in nets1:
+        raise TrainingDivergedError("the variant without dropout diverged on surface 1")
+    ft = [finetune_configs(n, seed=s)[1] for s in seeds]
+    chains2 = _chains(nets1, d2, shares, ft, seed, n_jobs)
+    chains3 = _chains([chain[-1].trained for chain in chains2], d3, shares, ft, seed, n_jobs)
+    paper, batch0_p0, paper2, paper3 = out["paper"]
+    n_seeds = len(seeds)
+    same = {0.0: nets1[0], 0.5: out["dropout"][0]}  # the sweep's runs trained already
+    sweep = dict(zip(sweep_ps, out["dropout"][n_seeds:], strict=True))
+    batches = {(None, 0.5): paper[0], (None, 0.0): batch0_p0}
+    for batch, ps in by_batch.items():
+        batches.update(zip([(batch, p) for p in ps], out["batch", batch], strict=True))
     return Networks(
         seeds=tuple(seeds),
-        paper=[c[0] for c in papers],
-        dropout=[out["dropout", s] for s in seeds],
-        variant=[c[0] for c in chains],
-        paper_transfer2=[c[1] for c in papers],
-        paper_transfer3=[c[2] for c in papers],
-        transfer2=[c[1] for c in chains],
-        transfer3=[c[2] for c in chains],
-        sweep={p: same[p] if p in same else out["sweep", p] for p in probabilities},
-        batches={
-            (b, p): papers[0][0] if (b, p) == (None, 0.5) else out["batch", b, p]
-            for b, p in BATCH_RUNS
-        },
-        scratch=out["scratch"],
+        paper=paper,
+        dropout=out["dropout"][:n_seeds],
+        variant=nets1,
+        paper_transfer2=paper2,
+        paper_transfer3=paper3,
+        transfer2=chains2,
+        transfer3=chains3,
+        sweep={p: same[p] if p in same else sweep[p] for p in probabilities},
+        batches={key: batches[key] for key in BATCH_RUNS},
+        scratch=out["scratch"][0],
     )
 
 

@@ -35,7 +35,8 @@ Steps
     parameter groups) cost a fifth of a BP network's step. The BP network's batches of windows
     run as one (rows, n_inputs) matrix, masked by a float32 mask: the same products, without
     the autograd nodes that reshape (windows, rows, n) inputs or the casts of a bool mask.
-    Both give the same bits.
+    Both give the same bits. BP networks that differ in seed or dropout only can also train
+    as one stack, each as it would alone (:func:`nctwin.learn.stack.fit_stack`).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
     the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
@@ -322,13 +323,18 @@ class _Programs:
         self.lengths = [len(x) for x in zx]
         self.start = np.cumsum([0, *self.lengths])[:-1]
 
-    def batch(self, windows: np.ndarray, w: int):
+    def batch(self, windows: np.ndarray, w: int, *, out=None):
         """Stack ``windows`` (B, 3) of (program, start, valid) into (B, w, n) inputs, targets
-        and a mask of valid, finite targets; rows past a window's valid length are zero."""
+        and a mask of valid, finite targets; rows past a window's valid length are zero.
+
+        ``out``: float32 arrays (B, w, n_inputs) and (B, w, n_outputs) to write the inputs and
+        targets into (by default, new ones)."""
         steps = np.arange(w)
         valid = steps < windows[:, 2:3]
         rows = np.where(valid, self.start[windows[:, 0:1]] + windows[:, 1:2] + steps, 0)
-        x, y = self.x[rows], self.y[rows]  # copies
+        x_out, y_out = out if out is not None else (None, None)
+        x = np.take(self.x, rows, axis=0, out=x_out)  # copies
+        y = np.take(self.y, rows, axis=0, out=y_out)
         x[~valid] = 0.0
         m = valid[..., None] & np.isfinite(y)
         y[~m] = 0.0
@@ -493,20 +499,15 @@ def fit(
             f"init has model config {init.model.config!r}, not model_config = {model_config!r}"
         )
     val_key = data_hash(*validation) if validation is not None else None
-    key = {"data": data_hash(xs, ys), "validation": val_key, "model": model_config.to_dict(),
-           "train": train_config.to_dict(),
-           "cpu": torch.backends.cpu.get_cpu_capability()}  # fmt: skip
-    if init is not None:  # only then, so that earlier keys stay valid
-        key["init"] = init.path.name
-    path = cache_path("models", name, content_key(key), ".pt")
+    path = checkpoint_path(
+        name, model_config, train_config, data_hash(xs, ys), validation_key=val_key, init=init
+    )
     diverged = path.with_suffix(".diverged")  # the message of a training that diverged
     if cache and diverged.exists():
         raise TrainingDivergedError(diverged.read_text(encoding="utf-8"))
     if cache and path.exists():
         return load_checkpoint(path)
 
-    deterministic = torch.are_deterministic_algorithms_enabled()
-    torch.use_deterministic_algorithms(True)
     try:
         if validation is not None:  # the given programs validate, all others train
             n = len(xs)
@@ -516,25 +517,56 @@ def fit(
             split = _split(len(xs), train_config)
         # dropout masks come from torch's global generator: seed it inside a forked state, so
         # training repeats bit for bit and the caller's random state is left as it was
-        with torch.random.fork_rng(devices=[]):
+        with torch.random.fork_rng(devices=[]), deterministic():
             torch.manual_seed(train_config.seed)
-            with one_thread(), threadpool_limits(1, user_api="blas"):
-                trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
+            trained = _train(model_config, train_config, xs, ys, path, progress, split, init)
     except TrainingDivergedError as error:
         if cache:
             atomic_write_text(diverged, str(error))
         raise
-    finally:
-        torch.use_deterministic_algorithms(deterministic)
     if cache:
         save_checkpoint(trained)
     return trained
 
 
-def _train(
-    model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, split, init=None
-) -> Trained:
-    t0 = time.perf_counter()
+def checkpoint_path(
+    name: str,
+    model_config: ModelConfig | BPConfig,
+    train_config: TrainConfig,
+    data_key: str,
+    *,
+    validation_key: str | None = None,
+    init: Trained | None = None,
+    **extra,
+) -> Path:
+    """The checkpoint of a training (see the module docstring): ``name`` and a SHA-256 of the
+    data's :func:`data_hash` (``data_key``, ``validation_key``), the configs, the CPU kernels,
+    ``init``'s checkpoint and ``extra`` (keys a variant of the loop adds, so that its networks
+    and :func:`fit`'s never share a file)."""
+    key = {"data": data_key, "validation": validation_key, "model": model_config.to_dict(),
+           "train": train_config.to_dict(),
+           "cpu": torch.backends.cpu.get_cpu_capability(), **extra}  # fmt: skip
+    if init is not None:  # only then, so that earlier keys stay valid
+        key["init"] = init.path.name
+    return cache_path("models", name, content_key(key), ".pt")
+
+
+@contextmanager
+def deterministic() -> Iterator[None]:
+    """Deterministic algorithms, one torch thread and one BLAS thread (see the module
+    docstring, "Determinism"); restored after."""
+    before = torch.are_deterministic_algorithms_enabled()
+    torch.use_deterministic_algorithms(True)
+    try:
+        with one_thread(), threadpool_limits(1, user_api="blas"):
+            yield
+    finally:
+        torch.use_deterministic_algorithms(before)
+
+
+def scaled_programs(cfg: TrainConfig, xs, ys, split, init: Trained | None = None):
+    """The scalers (fitted on the training programs of ``split``, or ``init``'s) and the
+    scaled training and validation programs (:class:`_Programs`)."""
     train_idx, val_idx = split
     if init is not None:
         x_scaler, y_scaler = init.x_scaler, init.y_scaler
@@ -543,6 +575,18 @@ def _train(
         y_scaler = Scaler.fit([ys[i] for i in train_idx])
     zx = [x_scaler.transform(x) for x in xs]
     zy = [y_scaler.transform(y) for y in ys]
+    return (
+        x_scaler, y_scaler,
+        _Programs([zx[i] for i in train_idx], [zy[i] for i in train_idx]),
+        _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx]),
+    )  # fmt: skip
+
+
+def _train(
+    model_config, cfg: TrainConfig, xs, ys, path: Path, progress: bool, split, init=None
+) -> Trained:
+    t0 = time.perf_counter()
+    x_scaler, y_scaler, programs, validation = scaled_programs(cfg, xs, ys, split, init)
     w = cfg.window_lines
     generator = torch.Generator().manual_seed(cfg.seed)
     rng = np.random.default_rng([cfg.seed, 2])
@@ -552,8 +596,6 @@ def _train(
         model = build(model_config, generator=generator)
     if init is not None:
         model.load_state_dict(init.model.state_dict())
-    programs = _Programs([zx[i] for i in train_idx], [zy[i] for i in train_idx])
-    validation = _Programs([zx[i] for i in val_idx], [zy[i] for i in val_idx])
     run = _AutogradRun(model, cfg, programs, validation)
     history: dict[str, list[float]] = {"train": [], "val": []}
     best, best_state, best_epoch, stale = math.inf, None, 0, 0
