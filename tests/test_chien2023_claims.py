@@ -80,7 +80,9 @@ def test_claims_at_the_papers_bars_with_seeds():
     t3 = claims["table3_bilstm"]
     assert t3.threshold == 6.0 and t3.seeds_passing == 5
     assert set(t3.requires) == {c.id for c in conditions}
-    assert claims["cam_underestimates"].whose == "ours" and claims["cam_underestimates"].holds
+    # CAM's underestimate holds with no method: a condition (each row's CAM error within 2
+    # points of the paper's, all above 8 %), not a claim
+    assert "cam_underestimates" not in claims
     assert np.isfinite(claims["table2_bilstm"].value)
 
 

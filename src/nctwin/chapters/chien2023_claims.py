@@ -261,8 +261,4 @@ def claims(
                 bootstrap_interval(per_seed, lambda a: np.abs(a.mean(0)).max()),
             )
         )
-    under = (rows.cam_s >= rows.measured_s).sum() + (rows_b.cam_s >= rows_b.measured_s).sum()
-    out.append(Claim("cam_underestimates", "nctwin: CAM underestimates on every row of Tables "
-                     "1-3 (count of rows where it does not)", float(under), "==", 0.0,
-                     whose="ours"))  # fmt: skip
     return out
