@@ -96,3 +96,14 @@ def test_members_that_cannot_share_a_stack_are_refused(models, trains, match) ->
     xs, ys = _programs(400)
     with pytest.raises(ValueError, match=match):
         fit_stack(models, trains, xs, ys, names=["x"] * len(models), cache=False)
+
+
+def test_a_kernel_pin_outside_make_keys_another_checkpoint(monkeypatch) -> None:
+    """A network trained without make's kernel pins (MKL_CBWR, ...) rounds differently, even
+    where torch reports the same CPU capability: it must not be reused under make."""
+    from nctwin.learn.train import KERNEL_PINS, checkpoint_path
+
+    monkeypatch.setenv("MKL_CBWR", "AVX2")
+    pinned = checkpoint_path("n", MODEL, TRAIN, "data")
+    monkeypatch.delenv("MKL_CBWR")
+    assert "MKL_CBWR" in KERNEL_PINS and checkpoint_path("n", MODEL, TRAIN, "data") != pinned

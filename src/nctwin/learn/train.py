@@ -39,9 +39,12 @@ Steps
     as one stack, each as it would alone (:func:`nctwin.learn.stack.fit_stack`).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
-    the training config and the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
-    ``AVX512`` on such a CPU outside it: their rounding differs, so a network trained outside
-    ``make`` is never reused by a chapter run through it), written atomically (temporary file,
+    the training config, the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
+    ``AVX512`` on such a CPU outside it) and the environment variables that pin the kernels of
+    torch, MKL, oneDNN, OpenBLAS and numpy (:data:`KERNEL_PINS`; on an AVX2-only CPU torch
+    reports ``AVX2`` either way, but MKL without ``MKL_CBWR`` trained the LinuxCNC chapter's
+    networks to other bits). Their rounding differs, so a network trained outside ``make`` is
+    never reused by a chapter run through it. Written atomically (temporary file,
     then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
     tensors and plain Python values only, never pickled objects. A training that diverges
     (:class:`TrainingDivergedError`) leaves ``<name>-<hash>.diverged``, its message, so that
@@ -70,14 +73,25 @@ from ..cache import atomic_write, atomic_write_text, cache_path, content_key
 from .models import BPConfig, BPNetwork, ModelConfig, SequenceModel, build, build_bp
 
 __all__ = [
+    "KERNEL_PINS",
     "Scaler",
     "TrainConfig",
     "Trained",
     "TrainingDivergedError",
+    "checkpoint_path",
+    "data_hash",
+    "deterministic",
     "fit",
     "load_checkpoint",
     "one_thread",
+    "scaled_programs",
 ]
+
+
+#: Environment variables with which ``make`` pins the CPU kernels of torch, MKL, oneDNN,
+#: OpenBLAS and numpy (see the Makefile); part of every checkpoint's key.
+KERNEL_PINS = ("ATEN_CPU_CAPABILITY", "MKL_CBWR", "ONEDNN_MAX_CPU_ISA", "OPENBLAS_CORETYPE",
+               "NPY_DISABLE_CPU_FEATURES")  # fmt: skip
 
 
 class TrainingDivergedError(RuntimeError):
@@ -545,7 +559,8 @@ def checkpoint_path(
     and :func:`fit`'s never share a file)."""
     key = {"data": data_key, "validation": validation_key, "model": model_config.to_dict(),
            "train": train_config.to_dict(),
-           "cpu": torch.backends.cpu.get_cpu_capability(), **extra}  # fmt: skip
+           "cpu": torch.backends.cpu.get_cpu_capability(),
+           "pins": {name: os.environ.get(name, "") for name in KERNEL_PINS}, **extra}  # fmt: skip
     if init is not None:  # only then, so that earlier keys stay valid
         key["init"] = init.path.name
     return cache_path("models", name, content_key(key), ".pt")
