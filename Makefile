@@ -42,8 +42,9 @@ export TERM := dumb
 
 # Same numbers on every x86-64 CPU with AVX2: numpy, OpenBLAS, torch (ATen, MKL, oneDNN) pick
 # their kernels by CPU, and AVX-512 kernels round differently from AVX2 ones (trained networks
-# then differ in every digit). Pinning all of them to the AVX2 paths changes nothing on an AVX2
-# machine and makes an AVX-512 machine compute what it does.
+# then differ in every digit). Pinning all of them to the AVX2 paths makes an AVX-512 machine
+# compute what an AVX2 one does; on an AVX2-only AMD EPYC, MKL_CBWR still changed the last bits
+# of trained networks, so checkpoint keys include these pins (nctwin.learn.train.KERNEL_PINS).
 ifeq ($(shell uname -m),x86_64)
 export NPY_DISABLE_CPU_FEATURES := X86_V4 AVX512_ICL AVX512_SPR
 export OPENBLAS_CORETYPE := Haswell
