@@ -39,13 +39,10 @@ Steps
     as one stack, each as it would alone (:func:`nctwin.learn.stack.fit_stack`).
 Checkpoints
     ``data/cache/models/<name>-<hash>.pt``, keyed by a SHA-256 of the data, the model config,
-    the training config, the CPU kernels torch runs (``AVX2`` under ``make``, which pins them,
-    ``AVX512`` on such a CPU outside it) and the environment variables that pin the kernels of
-    torch, MKL, oneDNN, OpenBLAS and numpy (:data:`KERNEL_PINS`; on an AVX2-only CPU torch
-    reports ``AVX2`` either way, but MKL without ``MKL_CBWR`` trained the LinuxCNC chapter's
-    networks to other bits). Their rounding differs, so a network trained outside ``make`` is
-    never reused by a chapter run through it. Written atomically (temporary file,
-    then ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
+    the training config, the CPU kernels torch runs and ``make``'s kernel pins (:data:`KERNEL_PINS`;
+    unpinned MKL rounds differently even on an AVX2-only CPU), so that a network trained outside
+    ``make`` is never reused by a chapter run through it. Written atomically (temporary file, then
+    ``os.replace``) and read with ``torch.load(..., weights_only=True)``: the file holds
     tensors and plain Python values only, never pickled objects. A training that diverges
     (:class:`TrainingDivergedError`) leaves ``<name>-<hash>.diverged``, its message, so that
     asking again raises again without training; it stops at the first NaN weight, after which
@@ -88,8 +85,7 @@ __all__ = [
 ]
 
 
-#: Environment variables with which ``make`` pins the CPU kernels of torch, MKL, oneDNN,
-#: OpenBLAS and numpy (see the Makefile); part of every checkpoint's key.
+#: Environment variables with which ``make`` pins the CPU kernels (Makefile), in every key.
 KERNEL_PINS = ("ATEN_CPU_CAPABILITY", "MKL_CBWR", "ONEDNN_MAX_CPU_ISA", "OPENBLAS_CORETYPE",
                "NPY_DISABLE_CPU_FEATURES")  # fmt: skip
 
