@@ -129,7 +129,8 @@ def fit_stack(
     list of Trained or None
         One per member, in order; None for a member whose training diverged (no epoch had a
         finite validation loss), which leaves ``<name>-<hash>.diverged`` as
-        :func:`~nctwin.learn.train.fit` does.
+        :func:`~nctwin.learn.train.fit` does. A member's ``train_seconds`` is the stack's wall
+        time until that member stopped.
 
     Raises
     ------
