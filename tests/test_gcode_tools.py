@@ -121,10 +121,25 @@ def test_a_tool_no_table_lists_is_still_estimated(tmp_path, capsys):
 
 
 @pytest.mark.usefixtures("linuxcnc_interpreter")
-def test_the_tool_an_m6_loads_is_named_or_refused():
-    # LinuxCNC's preview module reports no tool in the spindle after M6: a G41 without D would
-    # be read with diameter 0 where LinuxCNC runs T1's 3 mm, so it is refused at its line
-    text = "G21 G90\nT1 M6\nG41 G1 X10 Y5 F600 (comp on)\nG1 X20\nG40 G1 X30\nM2\n"
+def test_m6_puts_its_tool_in_the_spindle():
+    # the sim table's T2: D1.5, Z0.1. After T2 M6, G43 without H offsets by 0.1 mm and G41
+    # without D offsets the path by the radius, 0.75 mm, as LinuxCNC's iocontrol loads it
+    text = "G21 G90\nT2 M6\nG43\nG0 X0 Y0 Z5\nG41 G1 X10 Y0 F600\nG1 Y10\nG40 G1 X20 Y20\nM2\n"
+    tp = parse(text, tool_table=SIM)
+    np.testing.assert_allclose(tp.end_mm[:4], [[0, 0, 5.1], [9.25, 0.75, 5.1], [9.25, 10, 5.1],
+                                               [20, 20, 5.1]], atol=1e-9)  # fmt: skip
+    same = text.replace("G43\n", "G43 H2\n").replace("G41 ", "G41 D2 ")
+    np.testing.assert_allclose(parse(same, tool_table=SIM).end_mm, tp.end_mm, atol=1e-12)
+    # T0 M6 empties the spindle: size 0
+    empty = parse(text.replace("T2 M6", "T2 M6\nT0 M6"), tool_table=SIM)
+    np.testing.assert_allclose(empty.end_mm[1], [10, 0, 5], atol=1e-9)
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+def test_the_tool_m61_sets_is_named_or_refused():
+    # M61 calls nothing LinuxCNC's preview module passes on: a G41 without D after it would be
+    # read with the old tool's size where LinuxCNC runs T1's 3 mm, so it is refused at its line
+    text = "G21 G90\nM61 Q1\nG41 G1 X10 Y5 F600 (comp on)\nG1 X20\nG40 G1 X30\nM2\n"
     with pytest.raises(GCodeError, match=r":3: G41/G42 without D and G43 without H take the size"):
         parse(text, tool_table=SIM)
     named = parse(text.replace("G41 ", "G41 D1 "), tool_table=SIM)

@@ -379,7 +379,7 @@ def _value(row: pd.Series | None, column: str):
 EVERY_PROGRAM_SETS = ("public", "samples", "language")
 #: The experiment's design: recordings per set (the recording's name up to its first ``_``).
 DESIGN_COUNTS = {"train": 60, "broad": 100, "cam": 60, "test": 12, "lang": 9, "public": 14,
-                 "sample": 12}  # fmt: skip
+                 "sample": 17}  # fmt: skip
 #: The claims on the public programs, which need every program's path-control mode known
 #: (condition ``startup_mode_programs`` of :func:`experiment_conditions`).
 PUBLIC_CLAIMS = ("best_median_public", "best_worst_public", "best_beats_cam_public",

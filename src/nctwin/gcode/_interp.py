@@ -65,6 +65,10 @@ What differs from the native reader (by design)
 * Lines of blocks from a subroutine in another file are that file's lines; in such files
   (which are not instrumented) a line's state is the one the next reporting line gives.
 * The tool starts at machine zero (LinuxCNC's preview starts there); ``start_mm`` is refused.
+* ``M6`` puts the selected tool in the spindle, as LinuxCNC's ``iocontrol`` does on a
+  non-random tool changer, so ``G41``/``G42`` without D and ``G43`` without H take its size.
+  ``M61 Q`` calls nothing the child sees: in a program with ``M61`` such a line is refused
+  where the tool table gives any tool a size.
 * G94 sets LinuxCNC's feed to 0 (``convert_feed_mode``): the blocks after it carry NaN (no feed
   set) up to the next F, and a feed move there is LinuxCNC's error; the native reader does the
   same.
@@ -275,8 +279,8 @@ def read_linuxcnc(
     spindle = spindle_tool_line(tool_table, text)
     if spindle is not None:
         raise GCodeError(
-            spindle, "", "G41/G42 without D and G43 without H take the size of the tool M6 put"
-            " in the spindle, which LinuxCNC's preview module (this reader) never loads: name"
+            spindle, "", "G41/G42 without D and G43 without H take the size of the tool M61"
+            " put in the spindle, which LinuxCNC's preview module (this reader) never sees: name"
             " the tool (G41 D<n>, G43 H<n>)", source,
         )  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="nctwin-rs274-") as tmp:

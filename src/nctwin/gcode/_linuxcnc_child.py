@@ -101,7 +101,7 @@ class Canon:
         self.deadline = time.monotonic() + float(job["deadline_s"])
         self.moves, self.modal = array.array("d"), array.array("d")
         self.event_at, self.states = array.array("d"), bytearray()
-        self.stop = None
+        self.stop = self.spindle = None
         self.n_codes = None
         self.state = [math.nan, 1.0] + [0.0] * 10
         self._bind(int(job["max_moves"]) * 7)
@@ -211,8 +211,13 @@ class Canon:
     def get_block_delete(self):
         return self.block_delete
 
+    def change_tool(self, index):
+        self.spindle = index
+
     def get_tool(self, index):
-        return self.tools.get(index)
+        # M6 (CHANGE_TOOL) on a non-random tool changer: iocontrol copies the tool at ``index``
+        # into index 0, the spindle, where the interpreter reads it when it reloads the table
+        return self.tools.get(self.spindle if index == 0 and self.spindle else index)
 
     def check_abort(self):
         if time.monotonic() > self.deadline:

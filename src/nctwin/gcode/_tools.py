@@ -60,9 +60,10 @@ def complete_tool_table(table: str, program: str) -> str:
     return table + ("" if not added or table.endswith("\n") else "\n") + added
 
 
-#: A tool change (M6, M61) and the codes that take the size of the tool in the spindle when
-#: they name no tool: G41/G42 without D, G43 without H (not G41.1, G42.1, G43.1, G43.2).
-_CHANGE = re.compile(r"(?<![A-Z0-9.#])M0*6(?:1)?(?![.\d])", re.IGNORECASE)
+#: M61 (the spindle's tool set without a tool change) and the codes that take the size of the
+#: tool in the spindle when they name no tool: G41/G42 without D, G43 without H (not G41.1,
+#: G42.1, G43.1, G43.2).
+_CHANGE = re.compile(r"(?<![A-Z0-9.#])M0*61(?![.\d])", re.IGNORECASE)
 _SPINDLE_SIZED = {
     "D": re.compile(r"(?<![A-Z0-9.#])G0*4[12](?![.\d])", re.IGNORECASE),
     "H": re.compile(r"(?<![A-Z0-9.#])G0*43(?![.\d])", re.IGNORECASE),
@@ -70,12 +71,12 @@ _SPINDLE_SIZED = {
 
 
 def spindle_tool_line(table: ToolTable | None, program: str) -> int | None:
-    """The first line (1-based) of ``program`` that takes its size from the tool an ``M6`` put
+    """The first line (1-based) of a ``program`` with ``M61`` that takes its size from the tool
     in the spindle (``G41``/``G42`` without ``D``, ``G43`` without ``H``), where ``table``
     gives some tool a size; None if there is none. LinuxCNC's preview module, which the
-    interpreter reader runs, answers "no tool" for the spindle after every tool change
-    (``GET_EXTERNAL_TOOL_SLOT`` in gcodemodule.cc), so such a line would be read with size 0
-    where LinuxCNC runs the tool's size."""
+    interpreter reader runs, calls back on ``M6`` (the reader then loads the tool into the
+    spindle, as ``iocontrol`` does) but not on ``M61 Q``, so after it such a line would be read
+    with the size of the tool before, where LinuxCNC runs the new tool's size."""
     if table is None or not (any(table.diameter_mm) or any(map(any, table.offset_mm))):
         return None
     if not _CHANGE.search(_NOT_WORDS.sub(" ", program)):
