@@ -31,10 +31,10 @@ from .programs.pocket import pocket_program
 from .programs.training import broad_program, contour_program, training_specs
 from .recordings import (
     MACHINE,
-    PUBLIC_REJECTED,
     TRACE_PERIOD_S,
     RecordedProgram,
     recording_dir,
+    rejected_file,
     text_sha256,
     trace_sha256,
 )
@@ -320,7 +320,7 @@ def record_public(
         else:
             rejected[res[0]] = res[1]
     text = json.dumps(rejected, indent=1, sort_keys=True) + "\n"
-    atomic_write_text(out / PUBLIC_REJECTED.replace("public_", prefix), text)
+    atomic_write_text(out / rejected_file(prefix), text)
     return recorded, rejected
 
 

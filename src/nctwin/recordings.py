@@ -49,6 +49,7 @@ __all__ = [
     "load_recordings",
     "public_program_text",
     "recording_dir",
+    "rejected_file",
     "text_sha256",
     "trace_sha256",
 ]
@@ -162,8 +163,14 @@ def text_sha256(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-#: File listing the public programs nctwin or LinuxCNC rejects, with the reason.
-PUBLIC_REJECTED = "public_rejected.json"
+def rejected_file(prefix: str) -> str:
+    """The file listing the programs of a recorded set (``prefix`` its recordings' prefix,
+    ``public_`` or ``sample_``) that nctwin or LinuxCNC rejects, with the reason."""
+    return f"{prefix}rejected.json"
+
+
+#: The public programs' :func:`rejected_file`.
+PUBLIC_REJECTED = rejected_file("public_")
 
 
 def public_program_text(rec: RecordedProgram, folder: Path | None = None) -> str | None:
