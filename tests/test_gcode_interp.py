@@ -297,8 +297,7 @@ M2
 
 def test_task_words_from_the_modal_state(linuxcnc_interpreter):
     tp = parse(M_WORDS, reader="linuxcnc")
-    ev = tp.events
-    assert set(ev["word"]) == {"M"}
+    ev = tp.events[tp.events["word"] == "M"]  # G: the offsets (test_offsets_are_events)
     got = list(zip(ev["block"].tolist(), ev["line"].tolist(), ev["value"].tolist(), strict=True))
     assert got == [(1, 3, 3.0), (2, 5, 8.0), (3, 7, 9.0), (4, 9, 6.0), (5, 11, 0.0), (7, 15, 1.0),
                    (8, 17, 7.0)]  # fmt: skip
@@ -308,13 +307,28 @@ def test_task_words_from_the_modal_state(linuxcnc_interpreter):
     assert native[["block", "line", "value"]].tolist() == ev[["block", "line", "value"]].tolist()
 
 
+def test_offsets_are_events(linuxcnc_interpreter):
+    """Each line that sets an offset LinuxCNC's task waits for is one G event, by the first it
+    sets, in both readers: LinuxCNC's G55 sets three (G5x, G92, rotation), a G55 already in
+    force none; LinuxCNC's M2 resets the system after the last move."""
+    text = ("G21 G90 G54\nG0 X0 Y0 Z0\nG43 H1\nG1 X10 F600\nG55\nG55 G1 X20\nG92 X0\nG1 X5\n"
+            "G92.1\nG54 G92 X3\nG49 G1 X0\nM2\n")  # fmt: skip
+    expected = [(1, 3, 43.0), (2, 5, 54.0), (3, 7, 92.0), (4, 9, 92.0), (4, 10, 54.0),
+                (4, 11, 43.0)]  # fmt: skip
+    for reader, end in (("native", []), ("linuxcnc", [(5, 12, 54.0)])):
+        ev = parse(text, reader=reader).events
+        g = ev[ev["word"] == "G"]
+        got = list(zip(g["block"].tolist(), g["line"].tolist(), g["value"].tolist(), strict=True))
+        assert got == expected + end, reader
+
+
 def test_task_words_in_a_subroutine_and_a_full_turn(linuxcnc_interpreter):
     """Words inside a subroutine come at each call; a two-turn circle is two blocks."""
     text = ("o1 sub\nM8\nG91 G1 X1 F60\nG90\nM9\no1 endsub\n"
             "G0 X0 Y0\nG2 X0 Y0 I1 P2 F60\no1 call\no1 call\nM2")  # fmt: skip
     tp = parse(text, reader="linuxcnc")
     assert len(tp) == 5  # rapid, two turns, two lines
-    ev = tp.events
+    ev = tp.events[tp.events["word"] == "M"]
     assert ev["block"].tolist() == [3, 4, 4, 5] and ev["value"].tolist() == [8.0, 9.0, 8.0, 9.0]
     assert ev["line"].tolist() == [2, 5, 2, 5]
 

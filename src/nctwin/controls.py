@@ -351,10 +351,12 @@ class PlannerControl:
         True: the tool stops before the M-codes LinuxCNC's task waits for the motion to end
         for (:mod:`nctwin.estimate.task_waits`), as on LinuxCNC; False (default, a control
         that runs them on the fly): they neither stop it nor take time.
-    dwell_wait_s, spindle_wait_s, coolant_wait_s, tool_change_wait_s : float
+    dwell_wait_s, spindle_wait_s, coolant_wait_s, tool_change_wait_s, offset_wait_s : float
         How long the tool rests, beyond a dwell's own time, where the task stops it for a
-        dwell, a spindle word (``M3``-``M5``), a coolant word (``M7``-``M9``) or a tool change
-        (``M6``) between two moves (the words' with ``word_stops`` only), each in [0, 600] s.
+        dwell, a spindle word (``M3``-``M5``), a coolant word (``M7``-``M9``), a tool change
+        (``M6``) or an offset (``G43``, ``G49``, ``G92``, a new G54-G59.3; the
+        :data:`~nctwin.toolpath.OFFSET_EVENTS`) between two moves (the words' and offsets' with
+        ``word_stops`` only), each in [0, 600] s.
     """
 
     period_s: float = 0.001
@@ -364,6 +366,7 @@ class PlannerControl:
     spindle_wait_s: float = 0.0
     coolant_wait_s: float = 0.0
     tool_change_wait_s: float = 0.0
+    offset_wait_s: float = 0.0
 
     def __post_init__(self) -> None:
         _check_period(self.period_s)
@@ -372,7 +375,8 @@ class PlannerControl:
             raise ValueError(
                 f"word_stops = {self.word_stops!r} is not allowed: allowed True, False"
             )
-        for name in ("dwell_wait_s", "spindle_wait_s", "coolant_wait_s", "tool_change_wait_s"):
+        for name in ("dwell_wait_s", "spindle_wait_s", "coolant_wait_s", "tool_change_wait_s",
+                     "offset_wait_s"):  # fmt: skip
             check_range(name, getattr(self, name), 0.0, 600.0)
 
 

@@ -23,7 +23,9 @@ below are those of that source (function names in brackets) and were checked on 
 * The chain is flushed by a rapid (``STRAIGHT_TRAVERSE``), a dwell (``DWELL``), a new feed
   (``SET_FEED_RATE``, only if the value changes), any ``G61``/``G61.1``/``G64``
   (``SET_MOTION_CONTROL_MODE``), an S word (``SET_SPINDLE_SPEED``), M words (spindle, coolant,
-  tool change, stops, program end, I/O), and the program's end (``FINISH``). A T word
+  tool change, stops, program end, I/O), an offset (the origin offsets, ``SET_ORIGIN_OFFSETS``,
+  and the tool length offset, before which the task stops the motion in any case: the tool
+  path's ``G`` events), and the program's end (``FINISH``). A T word
   (``SELECT_POCKET``) and a plane change (``SELECT_PLANE``) do not flush it.
 * ``G64 P`` without Q sets :math:`Q = P`; a plain ``G64``, ``G64 P0`` and ``G61``/``G61.1``
   turn it off (``convert_control_mode`` in ``interp_convert.cc``); see
@@ -48,8 +50,8 @@ __all__ = ["MAX_CHAIN", "merge_naive_cam", "small_arc_points"]
 #: Most moves one merged line joins: ``linkable`` refuses a point once 101 are held.
 MAX_CHAIN = 101
 
-#: Event words that make LinuxCNC's canon flush the chain (a T word does not).
-_FLUSHING_WORDS = ("M", "S")
+#: Event words that make LinuxCNC's canon flush the chain (a T word does not; G: the offsets).
+_FLUSHING_WORDS = ("M", "S", "G")
 
 
 def small_arc_points(tp: Toolpath, q_mm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

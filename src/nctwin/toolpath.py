@@ -26,7 +26,8 @@ import numpy as np
 
 from ._rows import row_norm
 
-__all__ = ["EVENT_DTYPE", "PLANE_AXES", "MotionKind", "PathMode", "Plane", "Toolpath"]
+__all__ = ["EVENT_DTYPE", "OFFSET_EVENTS", "PLANE_AXES", "MotionKind", "PathMode", "Plane",
+           "Toolpath"]  # fmt: skip
 
 
 class MotionKind(enum.IntEnum):
@@ -60,6 +61,13 @@ class PathMode(enum.IntEnum):
 PLANE_AXES = np.array([[0, 1, 2], [2, 0, 1], [1, 2, 0]], dtype=np.intp)
 
 EVENT_DTYPE = np.dtype([("block", np.int64), ("line", np.int64), ("word", "U1"), ("value", "f8")])
+#: The events of word ``G``: a line that sets an offset, which LinuxCNC's task sets only once
+#: the motion has stopped (``emcTaskCheckPreconditions``), by the first it sets: 43 a tool
+#: length offset (G43, G43.1, G43.2, G49), 54 the work offset (a change of G54-G59.3, or G10
+#: L2/L20 of the system in force), 92 the G92 offset (G92, G92.1, G92.2, G92.3), 10 the XY
+#: rotation.
+OFFSET_EVENTS = {43.0: "tool length offset", 54.0: "work offset", 92.0: "G92 offset",
+                 10.0: "XY rotation"}  # fmt: skip
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -96,8 +104,9 @@ class Toolpath:
     naive_tol_mm : ndarray, shape (N,)
         The Q of the G64 in force (naive CAM detector tolerance), NaN where not given.
     events : structured ndarray, shape (E,)
-        Non-motion words kept in program order (M, S, T): fields ``block`` (index of the block
-        they precede), ``line``, ``word`` (letter) and ``value``.
+        Non-motion words kept in program order (M, S, T, and G for the offsets of
+        :data:`OFFSET_EVENTS`): fields ``block`` (index of the block they precede), ``line``,
+        ``word`` (letter) and ``value``.
     """
 
     start_mm: np.ndarray

@@ -7,17 +7,18 @@ a program pause (``M0``, and ``M1`` with the optional stop on, LinuxCNC's defaul
 command (``M3``, ``M4``, ``M5``), a tool change (``M6``), a coolant command (``M7``, ``M8``,
 ``M9``) and a dwell wait for the motion *and* I/O to be done (``WAITING_FOR_MOTION_AND_IO``),
 so the planner's queue drains and the tool stops before them; a tool length offset (``G43``,
-``G49``) and the G5x and G92 offsets wait for the motion too. Then the tool rests while task
-and I/O do the command; the times at rest are the ``[control.planner]`` settings of
-:class:`~nctwin.controls.PlannerControl`, measured on live runs (see the ``linuxcnc_sim``
-profile). A pause rests until the operator presses cycle start, which has no defined time:
-here a pause stops the tool and adds nothing (the motion time excludes the operator's wait).
+``G49``), the G5x and G92 offsets and the XY rotation wait for the motion too (the tool path's
+``G`` events, :data:`~nctwin.toolpath.OFFSET_EVENTS`). Then the tool rests while task and I/O
+do the command and the interpreter reads on; the times at rest are the ``[control.planner]``
+settings of :class:`~nctwin.controls.PlannerControl`, measured on live runs (see the
+``linuxcnc_sim`` profile). A pause rests until the operator presses cycle start, which has no
+defined time: here a pause stops the tool and adds nothing (the motion time excludes the
+operator's wait).
 
 What is modelled, where the control's ``word_stops`` is on (LinuxCNC's; otherwise only the
-dwells): the words of a tool path's events (M-codes) and its dwells, between the first and the
-last move (a wait before the first move or after the last is no part of the
-motion, as in a recording). Not modelled: ``G43``/``G49`` and offset changes in the middle of
-the motion, which a tool path keeps no event for (measured: 3-4 ms at rest after the stop).
+dwells): the words of a tool path's events (M-codes and offsets) and its dwells, between the
+first and the last move (a wait before the first move or after the last is no part of the
+motion, as in a recording).
 """
 
 from __future__ import annotations
@@ -83,7 +84,10 @@ def task_stops(
     ev = toolpath.events
     m = np.where(ev["word"] == "M", ev["value"], np.nan)
     waiting = np.isin(m, list(WAITING_M_CODES)) & control.word_stops
-    word_block = ev["block"][waiting]
+    # offsets set together (LinuxCNC's G55 sets the G5x and G92 offsets and the rotation) are
+    # one stop: one rest per block they precede
+    offset = np.unique(ev["block"][ev["word"] == "G"]) if control.word_stops else []
+    word_block = np.concatenate([ev["block"][waiting], offset]).astype(np.int64)
     moving = merged_source[source]
     merged_dwell = np.flatnonzero(np.isin(merged_source, dwell))
     after = np.union1d(
@@ -93,8 +97,8 @@ def task_stops(
     if not len(moving):
         return after, np.zeros(0, np.int64), np.zeros(0)
     first, last = moving[0], moving[-1]
-    rest_s = [getattr(control, WAITING_M_CODES[v]) if WAITING_M_CODES[v] else 0.0
-              for v in m[waiting]]  # fmt: skip
+    settings = [WAITING_M_CODES[v] for v in m[waiting]] + ["offset_wait_s"] * len(offset)
+    rest_s = [getattr(control, name) if name else 0.0 for name in settings]
     inside_word = (word_block > first) & (word_block <= last)
     inside_dwell = (dwell > first) & (dwell < last)
     rest_block = np.concatenate([word_block[inside_word], dwell[inside_dwell]])

@@ -29,7 +29,7 @@ def dump(tp: Toolpath, *, title: str | None = None) -> str:
     """
     out = [f"({title})" if title else "(written by nctwin)", "G21 G90 G90.1 G94 G17"]
     plane, feed, path = int(Plane.XY), np.nan, (int(PathMode.DEFAULT), np.nan, np.nan)
-    events = tp.events
+    events = tp.events[tp.events["word"] != "G"]  # the offsets are in the positions already
     ei = 0
     for k in range(len(tp)):
         while ei < len(events) and events["block"][ei] <= k:

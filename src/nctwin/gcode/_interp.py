@@ -98,7 +98,15 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import check_int, check_range
-from ..toolpath import EVENT_DTYPE, PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
+from ..toolpath import (
+    EVENT_DTYPE,
+    PLANE_AXES,
+    MotionKind,
+    PathMode,
+    Plane,
+    Toolpath,
+    arc_sweep,
+)
 from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
 from ._splines import task_splines
@@ -125,7 +133,10 @@ _MAX_LINE = 250  # LinuxCNC's LINELEN is 256: longer lines are left as they are
 #: The longest line LinuxCNC 2.9's interpreter reads (characters before the newline, measured:
 #: 253 gives "Command too long").
 LINUXCNC_MAX_LINE = 252
-_N_MOVE, _N_MODAL, _N_EVENT = 7, 13, 14
+_N_MOVE, _N_MODAL, _N_EVENT = 7, 15, 14
+#: The modal records' causes (the child's ``CAUSES``) that are offsets, by their value in
+#: :data:`~nctwin.toolpath.OFFSET_EVENTS`.
+_OFFSET_CAUSES = {2: 92.0, 3: 54.0, 4: 43.0, 5: 10.0}
 #: LinuxCNC's canon planes (1 XY, 2 YZ, 3 XZ) as :class:`Plane`.
 _PLANE_OF_CANON = np.array([0, Plane.XY, Plane.YZ, Plane.ZX], dtype=np.int8)
 _CYCLES = (730, 740, 810, 820, 830, 840, 850, 860, 870, 880, 890)
@@ -358,7 +369,7 @@ def _tables(raw: bytes):
     """The child's header and its tables: moves (M, 7), events (E, 14: the moves before each,
     then line, path mode, P, Q, units, feed mode, motion mode, the line's non-modal code, and
     the stop, spindle, tool-change, mist and flood M-codes of :mod:`._task_words`) and modal
-    records (K, 13)."""
+    records (K, 15)."""
     cut = raw.index(b"\n")
     header = json.loads(raw[:cut])
     sizes = header["bytes"]
@@ -596,10 +607,33 @@ def _toolpath(moves, events, modal, source) -> Toolpath:
     }
     if (turns > 1).any():
         fields = _expand_turns(fields, turns)
-    block = np.concatenate([[0], np.cumsum(turns)])[words[0]]  # a full turn is a block
-    events = np.array(list(zip(block, words[1], "M" * len(block), words[2], strict=True)),
-                      dtype=EVENT_DTYPE)  # fmt: skip
+    first_block = np.concatenate([[0], np.cumsum(turns)])  # a full turn is a block
+    offset = _offset_events(modal, events[:, 0].astype(np.int64))
+    events = np.zeros(len(words[0]) + len(offset[0]), EVENT_DTYPE)
+    events["block"] = first_block[np.concatenate([words[0], offset[0]])]
+    events["line"] = np.concatenate([words[1], offset[1]])
+    events["word"] = ["M"] * len(words[0]) + ["G"] * len(offset[0])
+    events["value"] = np.concatenate([words[2], offset[2]])
+    # in the order they ran (a subroutine's lines repeat): the M words, then the offsets
+    events = events[np.argsort(events["block"], kind="stable")]
     return Toolpath(**fields, events=events)
+
+
+def _offset_events(modal: np.ndarray, line: np.ndarray):
+    """The offsets LinuxCNC's task waits for the motion to set
+    (:data:`~nctwin.toolpath.OFFSET_EVENTS`), one per line that sets any, from the modal records
+    (K, 15) and the events' lines (E,): the moves made before each (it precedes the next), its
+    line and its value."""
+    cause = modal[:, 13].astype(np.int64)
+    rows = np.flatnonzero(np.isin(cause, list(_OFFSET_CAUSES)) & (modal[:, 14] > 0))
+    at = line[modal[rows, 14].astype(np.int64) - 1]  # the line running
+    rows, at = rows[at > 0], at[at > 0]  # line 0: the start code, not the program
+    moves = (modal[rows, 0] / _N_MOVE).astype(np.int64)
+    # a line's first call (G55 sets the G5x and G92 offsets and the rotation: one event)
+    first = np.ones(len(rows), bool)
+    first[1:] = (moves[1:] != moves[:-1]) | (at[1:] != at[:-1])
+    value = np.array([_OFFSET_CAUSES[c] for c in cause[rows[first]]], float)
+    return moves[first], at[first], value
 
 
 def _cycle_exact(kind, ev, after, start, end, plane) -> np.ndarray:

@@ -29,9 +29,10 @@ The output file holds a JSON header line, then the tables as raw bytes, in this 
 * events (one per ``next_line``): the moves made before it (float64), then the reported state
   itself, the ``settings`` (5 float64) and ``gcodes``/``mcodes`` (int32) arrays of the
   ``gcode.linecode`` object, copied from its memory (the header gives their lengths).
-* modal records, float64, 13 columns: the moves made before it, feed (in/min, NaN before the
+* modal records, float64, 15 columns: the moves made before it, feed (in/min, NaN before the
   first F), canon plane (1 XY, 2 YZ, 3 XZ), G92 offset (3), G5x offset (3), tool length offset
-  (3), XY rotation (degrees).
+  (3), XY rotation (degrees), then the call that made it (:data:`CAUSES`; -1 the initial state)
+  and the events (lines) reported before it.
 
 The callbacks are closures over local tables, not methods: they run once per move, and a
 closure's names cost less than attribute look-ups.
@@ -48,6 +49,9 @@ import time
 
 #: Offset of ``settings[]`` in a ``gcode.linecode`` object: after ob_refcnt and ob_type.
 _SETTINGS_OFFSET = 2 * ctypes.sizeof(ctypes.c_void_p)
+#: The canon calls of a modal record, by its cause column: feed, plane, and the offsets
+#: LinuxCNC's task runs only once the motion has stopped (G92, G5x, tool length, XY rotation).
+CAUSES = ("feed", "plane", "g92", "g5x", "tool", "rotation")
 
 
 class _Tool(ctypes.Structure):
@@ -105,7 +109,7 @@ class Canon:
         self.n_codes = None
         self.state = [math.nan, 1.0] + [0.0] * 10
         self._bind(int(job["max_moves"]) * 7)
-        self._push()
+        self._push(-1)
 
     def _bind(self, max_rows):
         """The per-move callbacks, as closures."""
@@ -159,33 +163,34 @@ class Canon:
         self.arc_feed, self.dwell, self.next_line = arc_feed, dwell, first_next_line
 
     # ---- state
-    def _push(self):
+    def _push(self, cause):
         self.modal.append(len(self.moves))
         self.modal.extend(self.state)
+        self.modal.extend((cause, len(self.event_at)))
 
     def set_feed_rate(self, rate):
         self.state[0] = rate
-        self._push()
+        self._push(0)
 
     def set_plane(self, plane):
         self.state[1] = plane
-        self._push()
+        self._push(1)
 
     def set_g92_offset(self, x, y, z, *rest):
         self.state[2:5] = [x, y, z]
-        self._push()
+        self._push(2)
 
     def set_g5x_offset(self, index, x, y, z, *rest):
         self.state[5:8] = [x, y, z]
-        self._push()
+        self._push(3)
 
     def tool_offset(self, x, y, z, *rest):
         self.state[8:11] = [x, y, z]
-        self._push()
+        self._push(4)
 
     def set_xy_rotation(self, degrees):
         self.state[11] = degrees
-        self._push()
+        self._push(5)
 
     def comment(self, text):  # every line has one (the parent's mark): nothing to keep
         return None

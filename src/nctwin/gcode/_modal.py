@@ -144,3 +144,18 @@ def _anchored(anchor: np.ndarray, value: np.ndarray, step: np.ndarray, initial: 
 
 def _fmt_g(code: int) -> str:
     return f"G{code // 10}" + (f".{code % 10}" if code % 10 else "")
+
+
+def offset_changes(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The lines (0-based) that set an offset LinuxCNC's task waits for the motion to set, with
+    the :data:`~nctwin.toolpath.OFFSET_EVENTS` value of the first a line sets (it runs the tool
+    length offset, the coordinate system, then G92): every G43 and G49, every G92.x, and a
+    G54-G59.3 that changes the system in force (LinuxCNC ignores the one in force)."""
+    coord = G[_COORD]
+    before = np.concatenate([[540], _ffill(coord >= 0, coord, 540)[:-1]])
+    masks = ((G[_TLO] >= 0, 43.0), ((coord >= 0) & (coord != before), 54.0),
+             (_IS_G92[G[_NONMODAL]], 92.0))  # fmt: skip
+    line = np.concatenate([np.flatnonzero(m) for m, _ in masks])
+    value = np.concatenate([np.full(int(m.sum()), v) for m, v in masks])
+    line, first = np.unique(line, return_index=True)  # a line's first, in the order it runs
+    return line, value[first]

@@ -59,6 +59,7 @@ from ._modal import (
     MM_PER_INCH,
     _ffill,
     _fmt_g,
+    offset_changes,
 )
 from ._tools import ToolTable, plain_positions, shift_by_offsets, tool_offsets
 
@@ -226,7 +227,7 @@ def _interpret(
             arc_tol,
         )  # fmt: skip
     blocks = _line_blocks(st, act, start, prev, pos, center, turns, via, dwell_t, cycles)
-    return _toolpath(words, st, blocks)
+    return _toolpath(words, G, st, blocks)
 
 
 @dataclass(frozen=True)
@@ -493,18 +494,21 @@ def _line_blocks(st: _Modal, act: _Actions, start, prev, pos, center, turns, via
     }
 
 
-def _toolpath(words, st: _Modal, blocks: dict) -> Toolpath:
-    """The Toolpath of the blocks, with the M, S and T words as events."""
-    code, value, line = words["code"], words["value"], words["line"]
-    bl = blocks["line"]
-    ev = np.isin(code, (_L["M"], _L["S"], _L["T"]))
-    events = np.zeros(int(ev.sum()), dtype=EVENT_DTYPE)
-    events["block"] = np.searchsorted(bl, line[ev], side="left")
-    stop = (code[ev] == _L["M"]) & np.isin(value[ev], _STOPS)  # they run after the motion
-    events["block"][stop] = np.searchsorted(bl, line[ev][stop], side="right")
-    events["line"] = line[ev] + 1
-    events["word"] = np.array(list(_LETTERS))[code[ev]]
-    events["value"] = value[ev]
+def _toolpath(words, G, st: _Modal, blocks: dict) -> Toolpath:
+    """The Toolpath of the blocks, with the M, S and T words and the offsets as events."""
+    ev = np.isin(words["code"], (_L["M"], _L["S"], _L["T"]))
+    off_line, off_value = offset_changes(G)
+    code = np.concatenate([words["code"][ev], np.full(len(off_line), _L["G"])])
+    value = np.concatenate([words["value"][ev], off_value])
+    line = np.concatenate([words["line"][ev], off_line])
+    bl, events = blocks["line"], np.zeros(len(code), dtype=EVENT_DTYPE)
+    events["block"] = np.searchsorted(bl, line, side="left")
+    stop = (code == _L["M"]) & np.isin(value, _STOPS)  # they run after the motion
+    events["block"][stop] = np.searchsorted(bl, line[stop], side="right")
+    events["line"] = line + 1
+    events["word"] = np.array(list(_LETTERS))[code]
+    events["value"] = value
+    events = events[np.lexsort((events["line"], events["block"]))]
     mode, blend_p, blend_q = st.mode[bl], st.blend_p[bl], st.blend_q[bl]
     exact = blocks["exact"]  # the moves of canned cycles run in exact-path mode
     mode[exact], blend_p[exact], blend_q[exact] = PathMode.EXACT_PATH, np.nan, np.nan
