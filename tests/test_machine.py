@@ -68,6 +68,7 @@ def test_linuxcnc_sim_has_the_fixed_limits():
         spindle_wait_s=0.004,
         coolant_wait_s=0.12,
         tool_change_wait_s=0.276,
+        offset_wait_s=0.0025,
     )
     assert p.default_method == "planner" and p.recordings == "linuxcnc"
 

@@ -21,6 +21,7 @@ WAITS = dataclasses.replace(
     spindle_wait_s=0.004,
     coolant_wait_s=0.12,
     tool_change_wait_s=0.276,
+    offset_wait_s=0.0025,
 )
 NO_WAITS = PlannerControl(period_s=WAITS.period_s, blend_tol_mm=WAITS.blend_tol_mm,
                           word_stops=True)  # fmt: skip
@@ -55,6 +56,18 @@ def test_words_outside_the_motion_take_no_time():
     assert blend_planner(parse(text), MACHINE, WAITS).cycle_time_s == pytest.approx(
         _time("(nothing)"), abs=1e-12
     )
+
+
+def test_offsets_stop_the_tool_once_between_two_moves():
+    """G92, G92.1, G43, G49 and a change of work system stop the tool and rest offset_wait_s;
+    several on the lines between the same two moves are one stop; G54 in force, G20/G21 and
+    G53 are none."""
+    stop = _time("G4 P0", NO_WAITS)
+    for word in ("G92 X10", "G92.1", "G43 H1", "G49", "G55", "G92.1\nG49\nG55 G92 X10"):
+        assert _time(word, NO_WAITS) == pytest.approx(stop, abs=1e-12), word
+        assert _time(word) == pytest.approx(stop + 0.0025, abs=1e-12), word
+    for word in ("G54", "G21", "(nothing)"):
+        assert _time(word) == pytest.approx(_time("(nothing)"), abs=1e-12), word
 
 
 def test_two_words_on_a_line_add_their_rests():
