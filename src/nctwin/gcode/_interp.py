@@ -98,15 +98,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import check_int, check_range
-from ..toolpath import (
-    EVENT_DTYPE,
-    PLANE_AXES,
-    MotionKind,
-    PathMode,
-    Plane,
-    Toolpath,
-    arc_sweep,
-)
+from ..toolpath import EVENT_DTYPE, PLANE_AXES, MotionKind, PathMode, Plane, Toolpath, arc_sweep
 from ._errors import GCodeError, _point_mm
 from ._modal import _HOMES, MM_PER_INCH
 from ._splines import task_splines
