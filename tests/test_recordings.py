@@ -3,10 +3,15 @@
 The live test records two short programs of the shipped set on LinuxCNC and compares them with
 the shipped recordings bit for bit (SHA-256 of the full position trace, per-block targets); it
 is skipped where LinuxCNC cannot run (``make linuxcnc``). Public programs (not shipped) are
-checked where ``../shared/programs`` lies beside the clone.
+checked where ``../shared/programs`` lies beside the clone. Every sample program LinuxCNC installs
+is either shipped and recorded or named in the public programs' README with the reason it is
+not (where LinuxCNC is installed).
 """
 
 import json
+import re
+from fnmatch import fnmatch
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +19,7 @@ import pytest
 from nctwin import record, recordings
 from nctwin.gcode import parse
 from nctwin.machine import load_profile
+from nctwin.paths import linuxcnc_samples_dir, public_programs_dir
 from nctwin.toolpath import MotionKind
 
 SHIPPED = recordings.load_recordings()
@@ -111,3 +117,27 @@ def test_live_recording_equals_shipped(name):
     assert live.trace_sha256 == shipped.trace_sha256
     np.testing.assert_array_equal(live.targets.junction_sample, shipped.targets.junction_sample)
     np.testing.assert_array_equal(live.feed_mm_s, shipped.feed_mm_s)
+
+
+#: Where Debian's linuxcnc-uspace installs LinuxCNC's sample programs.
+LINUXCNC_NC_FILES = Path("/usr/share/linuxcnc/ncfiles")
+
+
+@pytest.mark.usefixtures("linuxcnc_interpreter")
+def test_every_linuxcnc_sample_is_shipped_or_named_with_its_reason():
+    if not LINUXCNC_NC_FILES.is_dir():
+        pytest.skip(f"{LINUXCNC_NC_FILES} is missing")
+    shipped = sorted(p.name for p in linuxcnc_samples_dir().glob("*.ngc"))
+    assert {n for n in PUBLIC if n.startswith("sample_")} == {
+        "sample_" + Path(n).stem for n in shipped
+    }
+    readme = (public_programs_dir() / "README.md").read_text()
+    section = readme.split("## LinuxCNC's sample programs")[1].split("\n## ")[0]
+    reasons = section.split("not shipped, for one of these reasons:")[1].split("\n| file")[0]
+    named = re.findall(r"`([^`\s]+)`", reasons)
+    for path in sorted(LINUXCNC_NC_FILES.glob("*.ngc")):
+        if path.name in shipped:
+            continue
+        assert any(
+            fnmatch(path.name, n) or fnmatch(path.stem, n) or n in path.stem for n in named
+        ), f"{path.name}: neither shipped nor named in the public programs' README"
