@@ -304,9 +304,11 @@ lint: venv
 unit: venv
 	$(PY) -m pytest
 
-# chapter-runs: every chapter through papermill on a reader's input (tests/test_chapter_runs.py,
-# marked `chapter`, which a plain pytest leaves out): the "Your ..." section is there and
-# results/ is unchanged. After nbval, whose executions leave the networks in the cache.
+# chapter-runs: a chapter through papermill on a reader's input, as `make chapter` runs it
+# (tests/test_chapter_runs.py, marked `chapter`, which a plain pytest leaves out): the parameter
+# reaches the chapter, its tables go to the run's folder and results/ is unchanged. Every
+# chapter's own "Your ..." section runs in nbval, on the shipped examples. After nbval, whose
+# executions leave the chapter's data in the cache.
 chapter-runs: venv | $(EXECUTED)
 	$(PY) -m pytest -m chapter -p no:cacheprovider tests/test_chapter_runs.py
 

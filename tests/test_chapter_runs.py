@@ -1,45 +1,50 @@
-"""Every chapter run through papermill on a reader's input, as `make chapter` runs it: the
-"Your ..." section is there, the rest of the chapter ran, and ``results/`` is unchanged.
+"""Every chapter's "Your ..." section, and a chapter run through papermill on a reader's input.
 
-Marked ``chapter`` and left out of a plain ``pytest`` (``addopts``); ``make test`` runs them after
-nbval, whose executions leave the chapters' networks in the cache (``make chapters``).
+Each chapter ends with a section that runs its method on an input of the reader's (a program, a
+process, a surface), or on a shipped example when none is given. The book's executed notebooks
+(``book/notebooks/``, re-executed by ``make reproduce`` and checked by nbval in ``make test``)
+show it on the examples: the first tests read them. The last ones run a chapter as
+``make chapter`` runs it, through papermill on a reader's program: the parameter reaches the
+chapter, its tables go to the run's folder, ``results/`` is unchanged, and a program the chapter
+cannot run gets one line. They are marked ``chapter`` and left out of a plain ``pytest``
+(``addopts``); ``make test`` runs them after nbval, whose executions leave the chapter's data in
+the cache.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from pathlib import Path
 
 import pytest
 
 from nctwin.paths import repo_root, results_dir
 from nctwin.report import chapter
 
-pytestmark = pytest.mark.chapter
-
 ROOT = repo_root()
+EXECUTED = ROOT / "book" / "notebooks"
 EXAMPLE = ROOT / "data" / "programs" / "examples" / "bracket.ngc"
 
-#: Cycle-time chapters: the program parameter, and words of the section's table.
-PROGRAM_CHAPTERS = {
-    "chien2023_bilstm": ("cycle_time_s",),
-    "sun2022_axis_nn": ("cycle_time_s",),
-    "lee2022_block_overlap": ("cycle_time_s",),
-    "linuxcnc_real_kernel": ("cycle_time_s",),
-    "nist_hurco_real_machine": ("half_width_pct", "calibrated", "bilstm", "axis_nn"),
+#: Each chapter's section heading on its example, and words of the section's table.
+SECTIONS = {
+    "chien2023_bilstm": ("## Your program: `bracket.ngc`", ("cycle_time_s",)),
+    "sun2022_axis_nn": ("## Your program: `bracket.ngc`", ("cycle_time_s",)),
+    "lee2022_block_overlap": ("## Your program: `bracket.ngc`", ("cycle_time_s",)),
+    "linuxcnc_real_kernel": ("## Your program: `bracket.ngc`", ("cycle_time_s",)),
+    "nist_hurco_real_machine": (
+        "## Your program: `bracket.ngc`",
+        ("half_width_pct", "calibrated", "bilstm", "axis_nn"),
+    ),
+    "denkena2020_force_lstm": (
+        "## Your process: groove milling +x, ae 10 mm, ap 1 mm, vf 600 mm/min, n 5000 1/min",
+        ("lstm_cutting_rmse_n",),
+    ),
+    "zhang2023_step_error": ("## Your surface: `saddle.csv`", ("share_below_0.5um_pct",)),
 }
 
 
-def _results_digest() -> dict[str, str]:
-    folder = results_dir()
-    return {
-        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-        for p in sorted(folder.rglob("*"))
-        if p.is_file()
-    }
-
-
-def _outputs(executed) -> tuple[list[str], list[str]]:
+def _outputs(executed: Path) -> tuple[list[str], list[str]]:
     """The executed notebook's text outputs of its last cell, and every error's name."""
     nb = json.loads(executed.read_text(encoding="utf-8"))
     errors = [o["ename"] for c in nb["cells"] for o in c.get("outputs", [])
@@ -51,43 +56,50 @@ def _outputs(executed) -> tuple[list[str], list[str]]:
     return texts, errors
 
 
-def _run(stem: str, parameters: dict, tmp_path) -> tuple[list[str], list[str]]:
+@pytest.mark.parametrize("stem", list(SECTIONS))
+def test_the_book_shows_each_chapter_on_its_example(stem):
+    heading, words = SECTIONS[stem]
+    texts, errors = _outputs(EXECUTED / f"{stem}.ipynb")
+    assert errors == []
+    assert texts[0] == heading
+    assert all(word in texts[1] for word in words)
+    assert not any(t.startswith("not run:") for t in texts)
+
+
+def test_every_chapter_has_its_section():
+    chapters = {p.stem for p in (ROOT / "notebooks").glob("*.ipynb")}
+    assert chapters - set(SECTIONS) == {"paper_tables", "your_own_toolpath"}
+
+
+def _results_digest() -> dict[str, str]:
+    folder = results_dir()
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def _run(stem: str, parameters: dict, out: Path) -> tuple[list[str], list[str]]:
     before = _results_digest()
-    chapter.execute(chapter.resolve_notebook(stem, ROOT), tmp_path, parameters, ROOT)
+    chapter.execute(chapter.resolve_notebook(stem, ROOT), out, parameters, ROOT)
     assert _results_digest() == before, "the chapter changed results/"
-    assert (tmp_path / stem / "results").is_dir()  # its tables went to the run's folder
-    assert (tmp_path / f"{stem}.html").stat().st_size > 0
-    return _outputs(tmp_path / f"{stem}.ipynb")
+    assert (out / stem / "results").is_dir()  # its tables went to the run's folder
+    assert (out / f"{stem}.html").stat().st_size > 0
+    return _outputs(out / f"{stem}.ipynb")
 
 
-@pytest.mark.parametrize("stem", list(PROGRAM_CHAPTERS))
-def test_chapter_runs_your_program(stem, tmp_path):
-    texts, errors = _run(stem, {"program": str(EXAMPLE)}, tmp_path)
+@pytest.mark.chapter
+def test_a_chapter_runs_on_your_program(tmp_path):
+    program = tmp_path / "part.ngc"
+    program.write_bytes(EXAMPLE.read_bytes())
+    texts, errors = _run("lee2022_block_overlap", {"program": str(program)}, tmp_path / "out")
     assert errors == []
-    assert texts[0] == "## Your program: `bracket.ngc`"
-    assert all(word in texts[1] for word in PROGRAM_CHAPTERS[stem])
-    assert not any(t.startswith("not run:") for t in texts)
+    assert texts[0] == "## Your program: `part.ngc`"
+    assert "cycle_time_s" in texts[1]
 
 
-def test_denkena_runs_your_process(tmp_path):
-    texts, errors = _run("denkena2020_force_lstm", {"process": "groove,+x,10,1,600,5000"},
-                         tmp_path)  # fmt: skip
-    assert errors == []
-    assert texts[0] == ("## Your process: groove milling +x, ae 10 mm, ap 1 mm, vf 600 mm/min, "
-                        "n 5000 1/min")  # fmt: skip
-    assert "lstm_cutting_rmse_n" in texts[1]
-    assert not any(t.startswith("not run:") for t in texts)
-
-
-def test_zhang_runs_your_surface(tmp_path):
-    surface = ROOT / "data" / "surfaces" / "examples" / "saddle.csv"
-    texts, errors = _run("zhang2023_step_error", {"surface": str(surface)}, tmp_path)
-    assert errors == []
-    assert texts[0] == "## Your surface: `saddle.csv`"
-    assert "share_below_0.5um_pct" in texts[1]
-    assert not any(t.startswith("not run:") for t in texts)
-
-
+@pytest.mark.chapter
 def test_a_program_the_chapter_cannot_run_gets_one_line(tmp_path):
     bad = tmp_path / "tolerance.ngc"
     bad.write_text("G21 G90\nG64 P0.05\nG1 X10 F600\nM30\n", encoding="utf-8")

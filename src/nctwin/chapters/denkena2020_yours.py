@@ -48,6 +48,7 @@ from .denkena2020_bench import (
 from .your_program import domain_notes, show_section
 
 __all__ = [
+    "EXAMPLE_PROCESS",
     "FIELDS",
     "FLUTE_LENGTH_MM",
     "KIND_DIRECTIONS",
@@ -60,6 +61,10 @@ __all__ = [
 
 #: A process' fields, in the order of the string form.
 FIELDS = ("kind", "feed_direction", "ae_mm", "ap_mm", "vf_mm_min", "n_rpm")
+
+#: The process the chapter's "Your process" section runs when the reader gives none: groove
+#: milling in +x, ae 10 mm, ap 1 mm, vf 600 mm/min, n 5000 1/min.
+EXAMPLE_PROCESS = "groove,+x,10,1,600,5000"
 
 #: The feed directions of each kind, as the chapter runs them.
 KIND_DIRECTIONS = {

@@ -1,12 +1,13 @@
 r"""A reader's own program through a chapter: the paper's method beside the chapter's truth and
 CAM.
 
-Every cycle-time chapter takes a ``program`` parameter (a path to a G-code file). When it is set,
-the chapter runs as before and its last cell calls the chapter's ``your_program`` function, which
-returns a :class:`ProgramResult`, and :func:`show_program` displays it: the cycle times and their
-errors against the truth in a table, and the average feed per G-line, true and predicted, along
-the program in a figure. The networks are the chapter's own (trained above or read from the
-cache), never retrained for the program.
+Every cycle-time chapter takes a ``program`` parameter (a path to a G-code file; None, the
+default, is the shipped example :func:`example_program`). The chapter runs as before and its last
+cell calls the chapter's ``your_program`` function on it, which returns a :class:`ProgramResult`,
+and :func:`show_program` displays it: the cycle times and their errors against the truth in a
+table, and the average feed per G-line, true and predicted, along the program in a figure. The
+networks are the chapter's own (trained above or read from the cache), never retrained for the
+program.
 
 A program the chapter's machine cannot run (a construct it lacks, a file that is not G-code)
 gives a :class:`ProgramResult` with a one-line ``reason`` and nothing else; the rest of the chapter
@@ -25,6 +26,7 @@ import pandas as pd
 
 from ..gcode import read_text
 from ..metrics import error_pct
+from ..paths import data_dir
 from ..report.display import show
 from ..toolpath import Toolpath
 
@@ -33,6 +35,7 @@ __all__ = [
     "block_feeds",
     "block_summary",
     "domain_notes",
+    "example_program",
     "program_times",
     "run_program",
     "show_program",
@@ -162,6 +165,12 @@ def show_section(
     for note in notes:
         print(note)
     return True
+
+
+def example_program() -> Path:
+    """The shipped example program, ``data/programs/examples/bracket.ngc``: the "Your program"
+    section of each chapter runs it when no program of the reader's is given."""
+    return data_dir() / "programs" / "examples" / "bracket.ngc"
 
 
 def show_program(result: ProgramResult, *, truth_label: str = "truth") -> None:

@@ -9,7 +9,8 @@ readable by ``pandas.read_csv(path, index_col=0)``::
     1,5.0,5.1,5.2,5.5,...
 
 Both axes increase in equal steps (to 1 %), at least 4 values each; every cell is a finite
-number. ``data/surfaces/examples/saddle.csv`` is an example.
+number. ``data/surfaces/examples/saddle.csv`` is an example (:func:`example_surface`), the one
+the chapter's section shows when no surface of the reader's is given.
 
 It is interpolated by a bicubic spline through the grid
 (:class:`~nctwin.physics.surfaces.GridSurface`) and machined, as the chapter's surfaces, by an
@@ -37,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from ..learn.train import Trained
+from ..paths import data_dir
 from ..physics.steperror import sample_columns, step_error_samples, step_error_um
 from ..physics.surfaces import GridSurface, iso_parametric_path
 from ..report.papers import load_paper_table
@@ -48,11 +50,17 @@ __all__ = [
     "SPACING_TOLERANCE",
     "SurfaceResult",
     "bars_um",
+    "example_surface",
     "paper_path",
     "read_surface",
     "show_surface",
     "your_surface",
 ]
+
+def example_surface() -> Path:
+    """The shipped example surface, ``data/surfaces/examples/saddle.csv``."""
+    return data_dir() / "surfaces" / "examples" / "saddle.csv"
+
 
 #: Most path segments a reader's surface may have (the chapter's surfaces have 19,800).
 MAX_SEGMENTS = 200_000
