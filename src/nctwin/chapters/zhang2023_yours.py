@@ -57,6 +57,7 @@ __all__ = [
     "your_surface",
 ]
 
+
 def example_surface() -> Path:
     """The shipped example surface, ``data/surfaces/examples/saddle.csv``."""
     return data_dir() / "surfaces" / "examples" / "saddle.csv"
