@@ -258,7 +258,7 @@ def test_blend_arc_is_as_small_as_its_speed_allows():
     # d = R / tan(45 deg) = R
     tp = parse("G21 G90 G64\nG1 X100 F600\nY100\n", start_mm=(0, 0, 0))
     feed, _ = move_limits(tp, MACHINE)
-    v, d, arc, _ = junction_blends(
+    v, d, arc, _, _ = junction_blends(
         tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
     )
     r = max(10.0**2 / (NORMAL_ACC_RATIO * A), 10.0 * (10.0 / (A / 2)) / (math.pi / 2))
@@ -273,6 +273,27 @@ def test_blend_arc_is_as_small_as_its_speed_allows():
             tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
         )[1]
         assert d[0] == pytest.approx(expected)
+
+
+def test_a_blend_arc_between_two_feeds_runs_at_the_larger():
+    # LinuxCNC sizes a blend arc for the larger of the two feeds and runs it as a segment of its
+    # own at that speed; only its ends are held to the lines' feeds (tpGetRealFinalVel). A
+    # 90-degree corner, plain G64, 100 mm at 10 mm/s then 100 mm at 80 mm/s: the arc sized for
+    # 80 mm/s, R = 4 v^2 / (pi A) = 8.15 mm (as above), where sqrt(a_n R) = 84 mm/s > 80
+    tp = parse("G21 G90 G64\nG1 X100 F600\nY100 F4800\n", start_mm=(0, 0, 0))
+    feed, _ = move_limits(tp, MACHINE)
+    v, d, _, _, v_arc = junction_blends(
+        tp.lengths_mm, tp.end_tangents, tp.start_tangents, feed, np.full(2, np.inf), AXIS_ACC
+    )
+    r = 4 * 80.0**2 / (math.pi * A)
+    assert math.sqrt(NORMAL_ACC_RATIO * A * r) > 80.0
+    assert d[0] == pytest.approx(r)
+    assert v[0] == pytest.approx(10.0) and v_arc[0] == pytest.approx(80.0)
+    # LinuxCNC on linuxcnc_sim, live: a 8 mm plunge at 10 mm/s into an 80 mm line at 80 mm/s,
+    # 1.858 s in plain G64 (2.330 s with the arc held to 10 mm/s); 1.540 s from 40 mm/s
+    for plunge_feed, linuxcnc_s in ((600, 1.858), (2400, 1.540)):
+        program = f"G21 G90\nG0 Z5\nG1 Z-3 F{plunge_feed}\nG1 X80 F4800\n"
+        assert time_s(program) == pytest.approx(linuxcnc_s, abs=5e-4)
 
 
 def test_stops_fall_on_servo_periods():

@@ -243,8 +243,8 @@ def junction_blends(
     sized_arcs: bool = True,
     stop_turn_rad: float = STOP_TURN_RAD,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Blend arcs at the junctions of M moves: speed limit, consumed length, arc length and the
-    arc's acceleration.
+    """Blend arcs at the junctions of M moves: speed limit, consumed length, arc length, the
+    arc's acceleration and its own speed.
 
     Parameters
     ----------
@@ -273,6 +273,11 @@ def junction_blends(
         Length of the blend arc (0 where none is made).
     acc_mm_s2 : ndarray, shape (M - 1,)
         Acceleration of the blend arc (:func:`blend_plane_acc`; ``inf`` where none is made).
+    arc_speed_mm_s : ndarray, shape (M - 1,)
+        Speed of the blend arc itself (0 where none is made): LinuxCNC runs the arc as a
+        segment of its own at its planned speed, up to the larger of the two feeds
+        (``blendComputeParameters``' goal speed); ``v_mm_s``, the smaller of it and both feeds,
+        holds at its ends (``tpGetRealFinalVel``).
     """
     l1, l2 = length_mm[:-1], length_mm[1:]
     p = tol_mm[1:]
@@ -297,11 +302,13 @@ def junction_blends(
             r_plan = np.maximum(v_plan**2 / a_n, r_blend)
         radius = np.where(straight, np.inf, r_plan)
         d = np.where(straight, d_geom, radius / np.tan(theta))
-        v = np.minimum(np.sqrt(a_n * radius), np.minimum(feed_mm_s[:-1], feed_mm_s[1:]))
+        v_arc = np.minimum(np.sqrt(a_n * radius), np.maximum(feed_mm_s[:-1], feed_mm_s[1:]))
+        v = np.minimum(v_arc, np.minimum(feed_mm_s[:-1], feed_mm_s[1:]))
     v = np.where((p > 0) & (2.0 * theta >= stop_turn_rad), v, 0.0)
     arc = (v > 0) & ~straight
     arc_radius = np.where(arc, radius, 0.0)
-    return v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), acc
+    return (v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), acc,
+            np.where(arc, v_arc, 0.0))
 
 
 def tangent_junctions(

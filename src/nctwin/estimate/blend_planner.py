@@ -32,8 +32,10 @@ rules and constants are those of LinuxCNC's source (``emccanon.cc``, ``src/emc/t
    (:func:`junction_blends`, ``blendComputeParameters``), then the arc junctions' choices, the
    parabolic blends at half the moves' acceleration (:func:`parabolic_blend_speeds`,
    ``tpComputeBlendVelocity``) and the tangent passes.
-5. **Items** (:class:`Items`): line, blend arc, line, ...; a line's remainder the next blend
-   arc passes in under :data:`GAP_CYCLES` servo periods becomes part of it
+5. **Items** (:class:`Items`): line, blend arc, line, ...; a blend arc runs at its own planned
+   speed, up to the larger of its two moves' feeds, and its ends at the smaller of it and each
+   move's feed (``tpGetRealFinalVel``); a line's remainder the next blend arc passes in under
+   :data:`GAP_CYCLES` servo periods at the arc's speed becomes part of it
    (``blendCheckConsume``); a move with a parabolic end (the program's last, one before a
    dwell) runs at :math:`a/2` and is entered at most at its triangle speed.
 6. **End speeds and times** (:func:`_item_times`): each item at most at its length over
@@ -43,10 +45,8 @@ rules and constants are those of LinuxCNC's source (``emccanon.cc``, ``src/emc/t
    (:func:`~nctwin.estimate.blend_speeds.stops_on_periods`, ``tpCheckEndCondition``).
 
 Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits
-(``tpChooseBestBlend`` is applied at junctions with an arc only), a line consumed by a blend into
-the last move (LinuxCNC compares with the blend's planned speed; here with the junction's speed,
-which is lower into a short last move). The stops and rests of LinuxCNC's task around dwells and
-M-codes are :mod:`~nctwin.estimate.task_waits`'.
+(``tpChooseBestBlend`` is applied at junctions with an arc only). The stops and rests of
+LinuxCNC's task around dwells and M-codes are :mod:`~nctwin.estimate.task_waits`'.
 """
 
 from __future__ import annotations
@@ -293,6 +293,8 @@ class Junctions:
         Length of the blend arc (0: none).
     arc_acc_mm_s2 : ndarray
         Acceleration of the blend arc's plane (:func:`blend_plane_acc`).
+    arc_speed_mm_s : ndarray
+        Speed of the blend arc itself, up to the larger of the two moves' feeds (0: none).
     """
 
     speed_mm_s: np.ndarray
@@ -300,6 +302,7 @@ class Junctions:
     start_trim_mm: np.ndarray
     arc_mm: np.ndarray
     arc_acc_mm_s2: np.ndarray
+    arc_speed_mm_s: np.ndarray
 
     def where(self, mask: np.ndarray, **values: np.ndarray | float) -> Junctions:
         """These junctions with the fields ``values`` where ``mask`` holds."""
@@ -337,7 +340,7 @@ def _junctions(
         sized_arcs=rules.sized_arcs,
         stop_turn_rad=rules.stop_turn_rad,
     )
-    j = Junctions(blends[0], blends[1], blends[1], blends[2], blends[3])
+    j = Junctions(blends[0], blends[1], blends[1], blends[2], blends[3], blends[4])
     choice, para = kinds.choice, kinds.parabolic
     j = j.where(
         choice["choice"] == ARC_BLEND,
@@ -345,6 +348,7 @@ def _junctions(
         start_trim_mm=choice["trim2"],
         speed_mm_s=np.minimum(choice["v_plan"], np.minimum(feed[:-1], feed[1:])),
         arc_mm=choice["length"],
+        arc_speed_mm_s=choice["v_plan"],
     )
     j = j.where(kinds.kinked, speed_mm_s=choice["kink_speed"])
     j = j.where(kinds.kinked, end_trim_mm=0.0, start_trim_mm=0.0, arc_mm=0.0)
@@ -412,7 +416,12 @@ def _items(
     """Stage 5: the queue's items; a line remainder the next arc passes in under
     :data:`GAP_CYCLES` periods becomes part of it (``blendCheckConsume``)."""
     rem = j.remaining_mm(queue.moves.lengths_mm)
-    arc, v = j.arc_mm, j.speed_mm_s
+    arc = j.arc_mm
+    # a blend arc runs at its own planned speed; its ends at the smaller of it and the lines'
+    v = np.where(arc > 0, j.arc_speed_mm_s, j.speed_mm_s)
+    # into a move with a parabolic end at most at its triangle speed
+    triangle = np.sqrt(line_acc * queue.moves.lengths_mm)[1:]
+    exit_ = np.where(queue.parabolic_end[1:], np.minimum(v, triangle), v)
     with np.errstate(divide="ignore", invalid="ignore"):
         eat = (arc > 0) & (rem[:-1] < GAP_CYCLES * period_s * v) & ~queue.moves.is_arc[:-1]
     line_len = np.append(np.where(eat, 0.0, rem[:-1]), rem[-1])
@@ -422,7 +431,7 @@ def _items(
         acc_mm_s2=_interleave(line_acc, arc_acc),
         feed_mm_s=_interleave(feed, v),
         top_mm_s=_interleave(top, v),
-        end_limit_mm_s=np.append(np.repeat(v, 2), 0.0),
+        end_limit_mm_s=np.append(np.column_stack((v, exit_)).ravel(), 0.0),
     )
 
 
