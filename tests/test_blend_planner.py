@@ -294,6 +294,11 @@ def test_a_blend_arc_between_two_feeds_runs_at_the_larger():
     for plunge_feed, linuxcnc_s in ((600, 1.858), (2400, 1.540)):
         program = f"G21 G90\nG0 Z5\nG1 Z-3 F{plunge_feed}\nG1 X80 F4800\n"
         assert time_s(program) == pytest.approx(linuxcnc_s, abs=5e-4)
+    # the ablation's rule: the arc at the smaller feed, 10 mm/s
+    slow = estimate_planner(
+        parse("G21 G90\nG0 Z5\nG1 Z-3 F600\nG1 X80 F4800\n", start_mm=(0, 0, 0)), arc_speed=False
+    )
+    assert slow.cycle_time_s == pytest.approx(2.330, abs=5e-4)
 
 
 def test_stops_fall_on_servo_periods():

@@ -6,6 +6,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from nctwin import identify
@@ -250,3 +251,34 @@ def test_fit_planner_rejects_bad_input():
         identify.fit_planner([(tp, 0.0)], MACHINE, PLANNER)
     with pytest.raises(ValueError, match=r"start = \(500.0, 400.0\) is out of range"):
         identify.fit_planner([(tp, 1.0)], MACHINE, PLANNER, start=(500.0, 400.0))
+
+
+def test_planner_numbers_by_hand():
+    rows = pd.DataFrame(
+        [(p, s, m, r, e) for p, s, m, errs in (
+            ("train_1", "train", "G64 P Q0", (0.1, 0.1, 0.1, 0.1, 0.1)),
+            ("broad_1", "broad", "G64", (-2.0, 0.0, 0.0, 0.0, 0.0)),
+            ("cam_1", "cam", "G61", (0.2, 60.0, 0.2, 0.4, 0.3)),
+            ("cam_2", "cam", "G64", (-0.4, 0.1, -20.0, 0.8, 0.5)),
+            ("contour", "public", "G64", (9.0, 9.0, 9.0, 9.0, 9.0)),
+        ) for r, e in zip(("all", "no kinks", "largest arcs", "stops off periods",
+                           "blend arcs at the smaller feed"), errs, strict=True)],
+        columns=["program", "set", "mode", "rules", "err_pct"],
+    )  # fmt: skip
+    limits = pd.DataFrame(
+        {"axis": ["X", "Y", "X", "Y"],
+         "limit": ["acceleration_mm_s2"] * 2 + ["velocity_mm_s"] * 2,
+         "start": [500.0, 500.0, 100.0, 100.0], "fitted": [990.0, 1020.0, 190.0, 180.0],
+         "profile": [1000.0, 1000.0, 200.0, 200.0]}
+    )  # fmt: skip
+    n = rk.planner_numbers(rows, limits)
+    # the public program is not one of nctwin's own; the worst of the rest is broad_1's -2 %
+    assert n["own_n"] == 4 and n["own_worst"] == 2.0 and n["own_worst_signed"] == -2.0
+    assert n["own_worst_program"] == "broad_1"
+    assert n["own_cam_median"] == pytest.approx(0.3) and n["own_cam_worst"] == 0.4
+    assert n["no_kinks_g61_worst"] == 60.0 and n["largest_arcs_g64_worst"] == 20.0
+    assert n["all_cam_median"] == pytest.approx(0.3)
+    assert n["stops_off_cam_median"] == pytest.approx(0.6)
+    assert n["smaller_feed_cam_median"] == pytest.approx(0.4)
+    assert n["fit_Y_acc_fitted"] == 1020.0 and n["fit_X_vel_start"] == 100.0
+    assert n["fit_acc_worst_pct"] == pytest.approx(2.0)  # Y: 1020 for 1000

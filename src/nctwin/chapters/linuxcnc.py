@@ -73,6 +73,7 @@ __all__ = [
     "path_control",
     "planner_ablation",
     "planner_block_gaps",
+    "planner_numbers",
     "your_program",
 ]
 
@@ -220,8 +221,9 @@ def path_control(tp: Toolpath, profile: Profile) -> str:
 #: The rule sets of :func:`planner_ablation`: name -> keyword arguments of
 #: :func:`~nctwin.estimate.blend_planner.blend_planner`. The last is the planner as it was
 #: before the CAM-style recordings showed the rules for kinks and arcs missing, before stops
-#: were put on whole servo periods and programmed arcs split their acceleration at their speed
-#: limit, and with the near-reversal threshold it had then measured.
+#: were put on whole servo periods, programmed arcs split their acceleration at their speed
+#: limit and blend arcs ran at their own speed, and with the near-reversal threshold it had
+#: then measured.
 PLANNER_RULES = {
     "all": {},
     "no arc blends": {"arc_blends": False},
@@ -229,10 +231,12 @@ PLANNER_RULES = {
     "largest arcs": {"sized_arcs": False},
     "stops off periods": {"stop_periods": "off"},
     "arcs at their feed": {"arc_rules": False},
+    "blend arcs at the smaller feed": {"arc_speed": False},
     "as first written": {
         "kinks": False,
         "sized_arcs": False,
         "arc_rules": False,
+        "arc_speed": False,
         "stop_periods": "off",
         "stop_turn_rad": 0.02,
     },
@@ -243,8 +247,8 @@ def planner_ablation(
     programs: dict[str, tuple[str, Toolpath, float]], profile: Profile
 ) -> pd.DataFrame:
     """The blend-arc planner with and without its rules for blends at programmed arcs, for
-    nearly tangent junctions, for the size of blend arcs, for stops on whole servo periods and
-    for programmed arcs' acceleration (:data:`PLANNER_RULES`).
+    nearly tangent junctions, for the size of blend arcs, for stops on whole servo periods, for
+    programmed arcs' acceleration and for blend arcs' own speed (:data:`PLANNER_RULES`).
 
     The planner learns nothing from recordings, so for it the training sets are held-out
     programs: a check of its rules on programs that were not used to find them.
@@ -306,6 +310,57 @@ def method_summary(rows: pd.DataFrame, by: Sequence[str] = ("set", "method")) ->
         worst_abs_err_pct=("abs_err_pct", "max"),
         underestimates=("err_pct", lambda e: int((e < 0).sum())),
     ).reset_index()
+
+
+def planner_numbers(rules: pd.DataFrame, fit_limits: pd.DataFrame) -> dict[str, float | str]:
+    """The planner's numbers the chapter's prose quotes: on nctwin's own recordings (sets
+    ``train``, ``broad``, ``cam``) with all its rules, what its ablation's rules are worth on the
+    ``cam`` set, and its fitted axis limits.
+
+    Parameters
+    ----------
+    rules : DataFrame
+        :func:`planner_ablation`'s rows.
+    fit_limits : DataFrame
+        :func:`nctwin.identify.fit_planner`'s ``limits``: ``axis``, ``limit``
+        (``acceleration_mm_s2``, ``velocity_mm_s``), ``start``, ``fitted``, ``profile``.
+
+    Returns
+    -------
+    dict
+        ``own_n``, ``own_worst`` (|%|), ``own_worst_signed`` (%), ``own_worst_program``,
+        ``own_<set>_median`` and ``own_<set>_worst``; ``no_kinks_g61_worst`` and
+        ``largest_arcs_g64_worst`` (the worst ``cam`` program of that mode without the rule);
+        ``<rule>_cam_median`` for ``all``, ``stops_off`` and ``smaller_feed``;
+        ``fit_<axis>_<acc|vel>_<fitted|profile|start>`` and ``fit_acc_worst_pct``.
+    """
+    rules = rules.assign(abs_err=rules.err_pct.abs())
+    own = rules[(rules.rules == "all") & rules.set.isin(("train", "broad", "cam"))]
+    worst = own.abs_err.idxmax()
+    out: dict[str, float | str] = {
+        "own_n": float(len(own)),
+        "own_worst": own.abs_err[worst],
+        "own_worst_signed": own.err_pct[worst],
+        "own_worst_program": own.program[worst],
+    }
+    for group, errs in own.groupby("set").abs_err:
+        out[f"own_{group}_median"], out[f"own_{group}_worst"] = errs.median(), errs.max()
+    cam = rules[rules.set == "cam"]
+    by_mode = cam.groupby(["rules", "mode"]).abs_err.max()
+    out["no_kinks_g61_worst"] = by_mode[("no kinks", "G61")]
+    out["largest_arcs_g64_worst"] = by_mode[("largest arcs", "G64")]
+    median = cam.groupby("rules").abs_err.median()
+    for key, rule in (("all", "all"), ("stops_off", "stops off periods"),
+                      ("smaller_feed", "blend arcs at the smaller feed")):  # fmt: skip
+        out[f"{key}_cam_median"] = median[rule]
+    fit = fit_limits.set_index(["axis", "limit"])
+    for (axis, limit), row in fit.iterrows():
+        name = {"acceleration_mm_s2": "acc", "velocity_mm_s": "vel"}[limit]
+        for col in ("fitted", "profile", "start"):
+            out[f"fit_{axis}_{name}_{col}"] = float(row[col])
+    acc = fit.xs("acceleration_mm_s2", level="limit")
+    out["fit_acc_worst_pct"] = float((100 * (acc.fitted / acc.profile - 1)).abs().max())
+    return {k: v if isinstance(v, str) else float(v) for k, v in out.items()}
 
 
 # ------------------------------------------------------------------------------------------------

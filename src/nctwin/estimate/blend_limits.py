@@ -307,8 +307,13 @@ def junction_blends(
     v = np.where((p > 0) & (2.0 * theta >= stop_turn_rad), v, 0.0)
     arc = (v > 0) & ~straight
     arc_radius = np.where(arc, radius, 0.0)
-    return (v, np.where(arc, d, 0.0), arc_radius * (np.pi - 2.0 * theta), acc,
-            np.where(arc, v_arc, 0.0))
+    return (
+        v,
+        np.where(arc, d, 0.0),
+        arc_radius * (np.pi - 2.0 * theta),
+        acc,
+        np.where(arc, v_arc, 0.0),
+    )
 
 
 def tangent_junctions(

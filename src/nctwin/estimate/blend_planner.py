@@ -33,8 +33,9 @@ rules and constants are those of LinuxCNC's source (``emccanon.cc``, ``src/emc/t
    parabolic blends at half the moves' acceleration (:func:`parabolic_blend_speeds`,
    ``tpComputeBlendVelocity``) and the tangent passes.
 5. **Items** (:class:`Items`): line, blend arc, line, ...; a blend arc runs at its own planned
-   speed, up to the larger of its two moves' feeds, and its ends at the smaller of it and each
-   move's feed (``tpGetRealFinalVel``); a line's remainder the next blend arc passes in under
+   speed, up to the larger of its two moves' feeds (into a move with a parabolic end at most at
+   that move's triangle speed), and its ends at the smaller of it and each move's feed
+   (``tpGetRealFinalVel``); a line's remainder the next blend arc passes in under
    :data:`GAP_CYCLES` servo periods at the arc's speed becomes part of it
    (``blendCheckConsume``); a move with a parabolic end (the program's last, one before a
    dwell) runs at :math:`a/2` and is entered at most at its triangle speed.
@@ -45,7 +46,9 @@ rules and constants are those of LinuxCNC's source (``emccanon.cc``, ``src/emc/t
    (:func:`~nctwin.estimate.blend_speeds.stops_on_periods`, ``tpCheckEndCondition``).
 
 Not modelled: the parabolic blends LinuxCNC falls back to between two lines where no arc fits
-(``tpChooseBestBlend`` is applied at junctions with an arc only). The stops and rests of
+(``tpChooseBestBlend`` is applied at junctions with an arc only), a line consumed by a blend into
+the last move (LinuxCNC compares with the blend's planned speed; here with the speed the last
+move's triangle allows, which is lower into a short last move). The stops and rests of
 LinuxCNC's task around dwells and M-codes are :mod:`~nctwin.estimate.task_waits`'.
 """
 
@@ -168,13 +171,14 @@ def _queue(toolpath: Toolpath, control: PlannerControl) -> Queue | None:
 class Rules:
     """Which of LinuxCNC's rules the planner applies (:func:`blend_planner`'s switches):
     ``kinks``, ``sized_arcs``, ``arc_blends``, ``arc_ratio`` (:func:`move_limits`'s, from
-    ``arc_rules``) and ``stop_turn_rad``."""
+    ``arc_rules``), ``stop_turn_rad`` and ``arc_speed``."""
 
     kinks: bool
     sized_arcs: bool
     arc_blends: bool
     arc_ratio: str
     stop_turn_rad: float
+    arc_speed: bool = True
 
 
 @dataclasses.dataclass(frozen=True)
@@ -412,16 +416,23 @@ def _items(
     line_acc: np.ndarray,
     top: np.ndarray,
     period_s: float,
+    *,
+    arc_speed: bool,
 ) -> Items:
     """Stage 5: the queue's items; a line remainder the next arc passes in under
-    :data:`GAP_CYCLES` periods becomes part of it (``blendCheckConsume``)."""
+    :data:`GAP_CYCLES` periods becomes part of it (``blendCheckConsume``). With ``arc_speed``
+    off (the ablation), a blend arc runs at the speed of its ends."""
     rem = j.remaining_mm(queue.moves.lengths_mm)
     arc = j.arc_mm
-    # a blend arc runs at its own planned speed; its ends at the smaller of it and the lines'
-    v = np.where(arc > 0, j.arc_speed_mm_s, j.speed_mm_s)
-    # into a move with a parabolic end at most at its triangle speed
-    triangle = np.sqrt(line_acc * queue.moves.lengths_mm)[1:]
-    exit_ = np.where(queue.parabolic_end[1:], np.minimum(v, triangle), v)
+    v = j.speed_mm_s
+    if arc_speed:
+        # a blend arc runs at its own planned speed, its ends at the smaller of it and the
+        # lines'; into a move with a parabolic end at most at that move's triangle speed, as the
+        # junction's (_junctions)
+        triangle = np.sqrt(line_acc * queue.moves.lengths_mm)[1:]
+        own = np.where(queue.parabolic_end[1:], np.minimum(j.arc_speed_mm_s, triangle),
+                       j.arc_speed_mm_s)  # fmt: skip
+        v = np.where(arc > 0, own, v)
     with np.errstate(divide="ignore", invalid="ignore"):
         eat = (arc > 0) & (rem[:-1] < GAP_CYCLES * period_s * v) & ~queue.moves.is_arc[:-1]
     line_len = np.append(np.where(eat, 0.0, rem[:-1]), rem[-1])
@@ -431,7 +442,7 @@ def _items(
         acc_mm_s2=_interleave(line_acc, arc_acc),
         feed_mm_s=_interleave(feed, v),
         top_mm_s=_interleave(top, v),
-        end_limit_mm_s=np.append(np.column_stack((v, exit_)).ravel(), 0.0),
+        end_limit_mm_s=np.append(np.repeat(v, 2), 0.0),
     )
 
 
@@ -492,6 +503,7 @@ def blend_planner(
     sized_arcs: bool = True,
     arc_blends: bool = True,
     arc_rules: bool = True,
+    arc_speed: bool = True,
     stop_periods: str = "whole",
     stop_turn_rad: float = STOP_TURN_RAD,
 ) -> Estimate:
@@ -518,6 +530,9 @@ def blend_planner(
         limit (:func:`move_limits`) and the directions of parabolic blends at arcs
         (:func:`~nctwin.estimate.blend_junctions.parabolic_directions`); on by default, off
         for the ablation: the acceleration from the feed and the blends on the tangents.
+    arc_speed : bool
+        A blend arc runs at its own planned speed, up to the larger of its two moves' feeds
+        (:func:`junction_blends`); on by default, off for the ablation: at the smaller.
     stop_periods : {"whole", "mean", "off"}
         ``whole``: the tool comes to rest on a servo period (:func:`stops_on_periods`), as on
         LinuxCNC; ``mean``: each stop adds half a period instead, the mean of the same on
@@ -541,12 +556,12 @@ def blend_planner(
     if queue is None:
         return Estimate("planner", machine.name, toolpath.dwell_s.copy(), toolpath)
     arc_ratio = "max_speed" if arc_rules else "feed"
-    rules = Rules(kinks, sized_arcs, arc_blends, arc_ratio, stop_turn_rad)
+    rules = Rules(kinks, sized_arcs, arc_blends, arc_ratio, stop_turn_rad, arc_speed)
     limits = MoveLimits.of(queue.moves, machine)
     kinds = _junction_kinds(queue, limits, machine, control, rules)
     j, feed, acc, line_acc = _junctions(queue, kinds, limits, machine, rules)
     top = limits.at(finalized=queue.finalized, arc_ratio=rules.arc_ratio, top=True)[0]
-    items = _items(queue, j, feed, line_acc, top, control.period_s)
+    items = _items(queue, j, feed, line_acc, top, control.period_s, arc_speed=rules.arc_speed)
     t = _item_times(queue, j, items, feed, acc, control, stop_periods)
     move_t = t[0::2] + np.concatenate([[0.0], t[1::2] / 2]) + np.concatenate([t[1::2] / 2, [0.0]])
     block_t = np.bincount(queue.block, weights=move_t, minlength=len(toolpath))
