@@ -262,3 +262,16 @@ def test_a_profile_refuses_a_default_method_without_its_control():
         ValueError, match="default_method = 'planner' is out of range: allowed cam, kernel"
     ):
         Profile(machine, fir=FirControl(), default_method="planner")
+
+
+def test_best_method_passes_over_rows_a_profile_cannot_name():
+    from nctwin.estimate import best_method
+
+    summary = pd.DataFrame(
+        {"set": ["public", "public", "public", "test paths"],
+         "method": ["planner_fitted", "planner", "cam", "cam"],
+         "median_abs_err_pct": [0.03, 0.04, 9.0, 0.0], "worst_abs_err_pct": [1.0, 1.0, 20.0, 0.0]}
+    )  # fmt: skip
+    assert best_method(summary) == "planner"
+    # no public program: the test paths decide
+    assert best_method(summary[summary.set == "test paths"]) == "cam"

@@ -128,11 +128,13 @@ def cycle_time(
 
 
 def best_method(summary: pd.DataFrame) -> str:
-    """The method with the lowest median error on the public programs (on the test paths where
-    no public program was run): what a chapter that compares methods on a machine's recordings
-    recommends as its profile's ``default_method``."""
+    """The method of :data:`METHODS` with the lowest median error on the public programs (on the
+    test paths where no public program was run): what a chapter that compares methods on a
+    machine's recordings recommends as its profile's ``default_method``. A row of another name
+    (a method with fitted constants, such as ``planner_fitted``) is not a method a profile can
+    name, and is passed over."""
     group = "public" if (summary.set == "public").any() else "test paths"
-    rows = summary[summary.set == group].sort_values(
+    rows = summary[(summary.set == group) & summary.method.isin(list(METHODS))].sort_values(
         ["median_abs_err_pct", "worst_abs_err_pct"], kind="stable"
     )
     return str(rows.method.iloc[0])
