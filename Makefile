@@ -23,6 +23,8 @@ MATHJAX_DIR     := book/_vendor/mathjax
 NPM_CACHE       := build/npm
 CHROMIUM        ?= /usr/bin/chromium
 HTML_DIR        := book/_build/html
+# Processes of the unit tests that do not run LinuxCNC (pytest-xdist); CI has 2 cores.
+TEST_WORKERS    ?= 2
 
 # Source notebooks and the executed copies the book renders (committed).
 NOTEBOOKS := $(sort $(wildcard notebooks/*.ipynb))
@@ -301,8 +303,11 @@ test: venv linuxcnc lint nbval unit chapter-runs browser
 lint: venv
 	$(VENV)/bin/ruff check $(wildcard src tests benchmarks)
 
+# unit: the tests that do not run LinuxCNC on TEST_WORKERS processes (pytest-xdist), then the
+# live ones alone: a live run is timed against the servo thread and aborts on a loaded host.
 unit: venv
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_WORKERS) -m "not chapter and not live" --durations=15
+	$(PY) -m pytest -m "live and not chapter"
 
 # chapter-runs: a chapter through papermill on a reader's input, as `make chapter` runs it
 # (tests/test_chapter_runs.py, marked `chapter`, which a plain pytest leaves out): the parameter
@@ -323,7 +328,7 @@ nbval: venv | $(EXECUTED)
 	echo "nbval: $${nbs[*]}"; \
 	snap=build/results-before-nbval; rm -rf $$snap; mkdir -p build; cp -a results $$snap; status=0; \
 	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env \
-	  -p no:cacheprovider --color=no "$${nbs[@]}" || status=$$?; \
+	  -p no:cacheprovider --color=no --durations=20 "$${nbs[@]}" || status=$$?; \
 	changed=$$(diff -rq $$snap results | sed -E \
 	  -e "s#^Files $$snap/(.*) and results/.* differ\$$#  results/\1#" \
 	  -e "s#^Only in $$snap/?(.*): (.*)\$$#  results/\1/\2 (no longer written)#" \

@@ -19,12 +19,12 @@ from pathlib import Path
 
 import pytest
 
+from nctwin.chapters.your_program import example_program
 from nctwin.paths import repo_root, results_dir
 from nctwin.report import chapter
 
 ROOT = repo_root()
 EXECUTED = ROOT / "book" / "notebooks"
-EXAMPLE = ROOT / "data" / "programs" / "examples" / "bracket.ngc"
 
 #: Each chapter's section heading on its example, and words of the section's table.
 SECTIONS = {
@@ -92,7 +92,7 @@ def _run(stem: str, parameters: dict, out: Path) -> tuple[list[str], list[str]]:
 @pytest.mark.chapter
 def test_a_chapter_runs_on_your_program(tmp_path):
     program = tmp_path / "part.ngc"
-    program.write_bytes(EXAMPLE.read_bytes())
+    program.write_bytes(example_program().read_bytes())
     texts, errors = _run("lee2022_block_overlap", {"program": str(program)}, tmp_path / "out")
     assert errors == []
     assert texts[0] == "## Your program: `part.ngc`"
