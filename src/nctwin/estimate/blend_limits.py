@@ -242,7 +242,7 @@ def junction_blends(
     *,
     sized_arcs: bool = True,
     stop_turn_rad: float = STOP_TURN_RAD,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Blend arcs at the junctions of M moves: speed limit, consumed length, arc length, the
     arc's acceleration and its own speed.
 

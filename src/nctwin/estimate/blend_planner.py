@@ -178,7 +178,7 @@ class Rules:
     arc_blends: bool
     arc_ratio: str
     stop_turn_rad: float
-    arc_speed: bool = True
+    arc_speed: bool
 
 
 @dataclasses.dataclass(frozen=True)
@@ -375,10 +375,16 @@ def _junctions(
         j = j.where(para, speed_mm_s=speed)
     j = j.where(kinds.tangent, speed_mm_s=np.minimum(feed[:-1], feed[1:]))
     j = j.where(kinds.tangent | para, end_trim_mm=0.0, start_trim_mm=0.0, arc_mm=0.0)
-    # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed
+    # a move with a parabolic end runs at a / 2 and is entered at most at its triangle speed,
+    # the blend arc before it too
     line_acc = acc * np.where(queue.parabolic_end & ~halved, TANGENTIAL_ACC_RATIO, 1.0)
-    entry = np.minimum(j.speed_mm_s, np.sqrt(line_acc * length)[1:])
-    return j.where(queue.parabolic_end[1:], speed_mm_s=entry), feed, acc, line_acc
+    triangle = np.sqrt(line_acc * length)[1:]
+    j = j.where(
+        queue.parabolic_end[1:],
+        speed_mm_s=np.minimum(j.speed_mm_s, triangle),
+        arc_speed_mm_s=np.minimum(j.arc_speed_mm_s, triangle),
+    )
+    return j, feed, acc, line_acc
 
 
 @dataclasses.dataclass(frozen=True)
@@ -426,13 +432,8 @@ def _items(
     arc = j.arc_mm
     v = j.speed_mm_s
     if arc_speed:
-        # a blend arc runs at its own planned speed, its ends at the smaller of it and the
-        # lines'; into a move with a parabolic end at most at that move's triangle speed, as the
-        # junction's (_junctions)
-        triangle = np.sqrt(line_acc * queue.moves.lengths_mm)[1:]
-        own = np.where(queue.parabolic_end[1:], np.minimum(j.arc_speed_mm_s, triangle),
-                       j.arc_speed_mm_s)  # fmt: skip
-        v = np.where(arc > 0, own, v)
+        # a blend arc runs at its own planned speed, its ends at the smaller of it and the lines'
+        v = np.where(arc > 0, j.arc_speed_mm_s, v)
     with np.errstate(divide="ignore", invalid="ignore"):
         eat = (arc > 0) & (rem[:-1] < GAP_CYCLES * period_s * v) & ~queue.moves.is_arc[:-1]
     line_len = np.append(np.where(eat, 0.0, rem[:-1]), rem[-1])
