@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -110,10 +111,24 @@ def test_report_conditions_writes_the_csv_and_refuses_repeated_ids(tmp_path, cap
     c = Condition("lines", "G-lines", 5000, 4993, tol_pct=1.0)
     assert report_conditions("nb", [c], results_dir=tmp_path) == [c]
     text = (tmp_path / "nb" / "conditions.csv").read_text()
-    assert text == "id,text,paper,ours,unit,low,high,met\nlines,G-lines,5000,4993,,4950,5050,True\n"
+    assert text == (
+        "id,text,paper,ours,unit,low,high,met,why\nlines,G-lines,5000,4993,,4950,5050,True,\n"
+    )
     assert "4993" in capsys.readouterr().out
     with pytest.raises(ValueError, match=r"condition ids repeat: \['lines'\]"):
         report_conditions("nb", [c, c], results_dir=tmp_path)
+
+
+def test_an_unmet_conditions_why_is_written_and_shown_as_a_footnote(tmp_path, capsys):
+    why = "the paper does not publish it"
+    met = Condition("lines", "G-lines", 5000, 4993, tol_pct=1.0, why=why)
+    unmet = Condition("rate", "records per s", 2.9, 5.0, "1/s", tol_pct=25.0, why=why)
+    report_conditions("nb", [met, unmet], results_dir=tmp_path)
+    table = pd.read_csv(tmp_path / "nb" / "conditions.csv", keep_default_na=False)
+    assert table.why.tolist() == ["", why]  # a met condition needs no reason
+    shown = capsys.readouterr().out
+    assert "False [1]\\n[1] the paper does not publish it'" in shown
+    assert "<li>the paper does not publish it</li>" in shown
 
 
 def test_with_seeds_counts_the_single_networks_that_pass(tmp_path, capsys):
@@ -155,3 +170,15 @@ def test_in_a_notebook_the_chapter_status_is_glued(tmp_path, monkeypatch, capsys
     report_claims("s", CLAIMS[:2], results_dir=tmp_path)
     assert glued == {"chapter_status": "partly reproduced",
                      "chapter_status_why": "1 of the paper's 2 claims hold, 1 fail."}  # fmt: skip
+
+
+def test_every_unmet_condition_of_a_chapter_says_why():
+    """The shipped chapters' conditions: each one unmet names why it cannot be met."""
+    results = Path(__file__).resolve().parents[1] / "results"
+    files = sorted(results.glob("*/conditions.csv"))
+    assert files, "no chapter wrote conditions.csv"
+    for path in files:
+        table = pd.read_csv(path, keep_default_na=False)
+        assert list(table.columns) == list(CONDITION_COLUMNS), path
+        silent = table[(table.met.astype(str) == "False") & (table.why.str.strip() == "")]
+        assert silent.empty, f"{path.parent.name}: unmet without a why: {silent.id.tolist()}"

@@ -43,6 +43,37 @@ FIG9_MAX_TOL_PCT = 10.0
 PAPER_FAMILIES = ("paper_global", "paper_mixed")
 #: A training set's run time is the paper's within this tolerance (%; it prints "~2 h", "~3 h").
 HOURS_TOL_PCT = 25.0
+#: Why an unmet condition cannot be met from what the paper publishes (Condition.why).
+_WHY_UNKNOWN_KERNEL = (
+    "The paper publishes its kernel's feeds, tolerances and period, not its filters' time "
+    "constants nor its axes' limits. On every machine of the calibration's grid CAM's error "
+    "here falls less from the smaller tolerance to the larger than on the paper's kernel, a "
+    "property of the kernel's corner speeds, not of the paths; no setting of the paths meets "
+    "every row, and the one chosen puts the rows on either side of the paper's."
+)
+_WHY = {
+    "table1": _WHY_UNKNOWN_KERNEL,
+    "table2": _WHY_UNKNOWN_KERNEL,
+    "table3": (
+        "The paper publishes machine B's feeds and tolerances and the pocket's CAM times, not "
+        "the machine's time constants or limits nor the pocket's shape. CAM's error on machine "
+        "B grows with the feed where the paper's does not; at the widest band the pocket's path "
+        "allows and a stepover of the tool's diameter, the rows at the lower feed lie near the "
+        "paper's and those at the higher feed above."
+    ),
+    "fig9_min_avg_feed": (
+        "The slowest G-lines of the zoom are the short chords of the links that turn the "
+        "zig-zag around the island's corners: such a link is shorter than the path the filters "
+        "average over, so it runs at the speed of the turn between two rows. The paper shows "
+        "its pocket as a picture and three statistics (lines, path, measured time), which fix "
+        "neither its links nor their feeds."
+    ),
+    "fig9_max_avg_feed": (
+        "The zoom's rows are too short to reach the programmed feed, where the paper's zoom "
+        "holds straights long enough to. The rows' length follows from the band, which CAM's "
+        "error on Table 2's rows fixes; a wider band, with rows long enough, would miss them."
+    ),
+}
 #: Per table: (summary quantity of the paper's accuracy, our runs' toolpaths or None for all,
 #: training set).
 TABLE_CLAIMS = {"table1": ("table1_bilstm_accuracy", ("I", "II"), "sim"),
@@ -110,7 +141,8 @@ def _cam_conditions(table: str, rows: pd.DataFrame) -> list[Condition]:
                       f"eps = {r.tol_mm:g} mm (measured/CAM {r.measured_s / r.cam_s:.2f}, paper "
                       f"{r.measured_s_paper / r.cam_s_paper:.2f}; within {CAM_POINTS:g} points)",
                       r.cam_err_pct_paper, r.cam_err_pct, "%",
-                      low=r.cam_err_pct_paper - CAM_POINTS, high=r.cam_err_pct_paper + CAM_POINTS)
+                      low=r.cam_err_pct_paper - CAM_POINTS, high=r.cam_err_pct_paper + CAM_POINTS,
+                      why=_WHY[table])
             for r in merged.itertuples()]  # fmt: skip
 
 
@@ -195,10 +227,10 @@ def paper_conditions(
         Condition("fig9_min_avg_feed", f"Sec. 4.1, Fig. 9: lowest average feed of G-lines {lo}-"
                   f"{hi} of the pocket (within a factor {FIG9_MIN_FACTOR:g})", fig_min,
                   np.nanmin(zoom), "mm/s", low=fig_min / FIG9_MIN_FACTOR,
-                  high=fig_min * FIG9_MIN_FACTOR),
+                  high=fig_min * FIG9_MIN_FACTOR, why=_WHY["fig9_min_avg_feed"]),
         Condition("fig9_max_avg_feed", f"Sec. 4.1, Fig. 9: highest average feed of G-lines {lo}-"
                   f"{hi} (within {FIG9_MAX_TOL_PCT:g} %)", fig_max, np.nanmax(zoom), "mm/s",
-                  tol_pct=FIG9_MAX_TOL_PCT),
+                  tol_pct=FIG9_MAX_TOL_PCT, why=_WHY["fig9_max_avg_feed"]),
     ]  # fmt: skip
     for name in ("sim", "b"):
         out += _budget_conditions(name, sets[name], train_hours[name])

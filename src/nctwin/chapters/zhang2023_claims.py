@@ -37,6 +37,13 @@ __all__ = [
 #: before looking.
 MAX_ERR_TOL_PCT = 10.0
 _PAPER = "Zhang et al. 2023"
+#: Why a surface's step errors reach below the paper's smallest (Condition.why).
+_WHY_SMALLEST = (
+    "The paper gives its surfaces' bounding boxes, not their shapes. Ours are smooth stand-ins "
+    "with convex and concave regions, whose paths cross inflections, where a segment's step "
+    "error goes to 0. It matters to relative errors only, which no claim judges: the "
+    "relative-error tables count only the samples at or above the paper's smallest."
+)
 #: The network timed for Table 8 (a network's time depends on its architecture, not its weights).
 _NET = "the network of the paper's recipe fine-tuned to surface 2 (the chapter's seed)"
 
@@ -89,7 +96,8 @@ def paper_conditions(
                       tol_pct=MAX_ERR_TOL_PCT),
             Condition(f"s{i}_err_above_min", f"{cite} step errors at or above the paper's "
                       f"smallest ({p['step_err_min_um']:g} um), % of samples", 100.0,
-                      100.0 * float(np.mean(err >= p["step_err_min_um"])), "%", tol_pct=0.0),
+                      100.0 * float(np.mean(err >= p["step_err_min_um"])), "%", tol_pct=0.0,
+                      why=_WHY_SMALLEST),
         ]  # fmt: skip
     out.append(Condition("paper_recipe_fine_tuned", f"{_PAPER}, Tables 4-7: the paper's own "
                          "network fine-tuned to surfaces 2 and 3 (1 = done here)", 1.0,

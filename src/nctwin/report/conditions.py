@@ -10,7 +10,9 @@ A claim whose conditions are unmet is *not tested*: it neither holds nor fails
 (:func:`nctwin.report.claims.report_claims`).
 
 A condition is met when ours lies within ``[low, high]``: bounds given directly, or from the
-paper's value and a relative tolerance, :math:`|x - p| \le \text{tol}\,|p| / 100`.
+paper's value and a relative tolerance, :math:`|x - p| \le \text{tol}\,|p| / 100`. A
+condition the chapter cannot meet says why (:attr:`Condition.why`): what the paper does not
+publish, or what the truth cannot give; ``conditions.csv`` holds it beside the unmet row.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from .results import write_table
 __all__ = ["CONDITION_COLUMNS", "Condition", "conditions_table", "report_conditions"]
 
 #: Columns of ``conditions.csv``.
-CONDITION_COLUMNS = ("id", "text", "paper", "ours", "unit", "low", "high", "met")
+CONDITION_COLUMNS = ("id", "text", "paper", "ours", "unit", "low", "high", "met", "why")
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,9 @@ class Condition:
         Relative tolerance around ``paper``, in percent, stated before looking.
     low, high : float, optional
         Bounds instead of a tolerance (either may be infinite).
+    why : str, optional
+        Why ours cannot meet the condition from what the paper publishes (or what the truth
+        gives), with the evidence; written and shown only where the condition is unmet.
 
     Raises
     ------
@@ -65,6 +70,7 @@ class Condition:
     tol_pct: float | None = None
     low: float | None = None
     high: float | None = None
+    why: str = ""
 
     def __post_init__(self) -> None:
         bounds = self.low is not None or self.high is not None
@@ -97,7 +103,8 @@ class Condition:
 def conditions_table(conditions: Iterable[Condition]) -> pd.DataFrame:
     """The conditions as ``conditions.csv`` holds them (:data:`CONDITION_COLUMNS`)."""
     rows = [{"id": c.id, "text": c.text, "paper": c.paper, "ours": c.ours, "unit": c.unit,
-             "low": c.bounds[0], "high": c.bounds[1], "met": c.met}
+             "low": c.bounds[0], "high": c.bounds[1], "met": c.met,
+             "why": "" if c.met else c.why}
             for c in conditions]  # fmt: skip
     return pd.DataFrame(rows, columns=list(CONDITION_COLUMNS))
 
@@ -105,8 +112,8 @@ def conditions_table(conditions: Iterable[Condition]) -> pd.DataFrame:
 def report_conditions(
     stem: str, conditions: Iterable[Condition], *, results_dir: Path | None = None
 ) -> list[Condition]:
-    """Write ``results/<stem>/conditions.csv`` and show it; return the conditions (for
-    :func:`nctwin.report.claims.report_claims`).
+    """Write ``results/<stem>/conditions.csv`` and show it, the unmet conditions' reasons as
+    footnotes; return the conditions (for :func:`nctwin.report.claims.report_claims`).
 
     Raises
     ------
@@ -119,5 +126,5 @@ def report_conditions(
         raise ValueError(f"condition ids repeat: {sorted({i for i in ids if ids.count(i) > 1})}")
     table = conditions_table(conditions)
     write_table(stem, "conditions", table, results_dir=results_dir)
-    show(table[["text", "paper", "ours", "unit", "low", "high", "met"]])
+    show(table[["text", "paper", "ours", "unit", "low", "high", "met", "why"]], notes="why")
     return conditions

@@ -36,6 +36,30 @@ def format_table(df: pd.DataFrame) -> str:
     )
 
 
+def _footnoted(body: pd.DataFrame, column: str) -> tuple[pd.DataFrame, list[str]]:
+    """``body`` with the texts of ``column`` replaced by numbered references (``[1]`` ...; the
+    column dropped where no row has a text) and the texts, each once, in order."""
+    if column not in body.columns:
+        return body, []
+    footnotes: list[str] = []
+    refs = []
+    for note in body[column]:
+        if isinstance(note, str) and note.strip():
+            if note not in footnotes:
+                footnotes.append(note)
+            refs.append(f"[{footnotes.index(note) + 1}]")
+        else:
+            refs.append("")
+    body = body.drop(columns=column)
+    if footnotes:
+        body[column] = refs
+    return body, footnotes
+
+
+def _with_footnotes(text: str, footnotes: list[str]) -> str:
+    return "\n".join([text] + [f"[{i}] {note}" for i, note in enumerate(footnotes, start=1)])
+
+
 def _paper_parts(df: pd.DataFrame, name: str | None) -> tuple[list[str], pd.DataFrame, list[str]]:
     """Title parts, body and footnotes of a paper table (:func:`format_paper_table`)."""
     body = df.copy()
@@ -44,19 +68,7 @@ def _paper_parts(df: pd.DataFrame, name: str | None) -> tuple[list[str], pd.Data
         if column in body.columns and body[column].nunique(dropna=False) == 1:
             title.append(str(body[column].iloc[0]))
             body = body.drop(columns=column)
-    footnotes: list[str] = []
-    if "note" in body.columns:
-        refs = []
-        for note in body["note"]:
-            if isinstance(note, str) and note.strip():
-                if note not in footnotes:
-                    footnotes.append(note)
-                refs.append(f"[{footnotes.index(note) + 1}]")
-            else:
-                refs.append("")
-        body = body.drop(columns="note")
-        if footnotes:
-            body["note"] = refs
+    body, footnotes = _footnoted(body, "note")
     return title, body, footnotes
 
 
@@ -76,11 +88,10 @@ def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
     """
     title, body, footnotes = _paper_parts(df, name)
     lines = [" | ".join(title), format_table(body)] if title else [format_table(body)]
-    lines += [f"[{i}] {text}" for i, text in enumerate(footnotes, start=1)]
-    return "\n".join(lines)
+    return _with_footnotes("\n".join(lines), footnotes)
 
 
-def show(df: pd.DataFrame, *, digits: int = 4) -> None:
+def show(df: pd.DataFrame, *, digits: int = 4, notes: str | None = None) -> None:
     """Display a table once: compact HTML in the book, :func:`format_table` text beside it.
 
     One display object carries both forms: ``text/html`` (:func:`nctwin.report.html.html_table`,
@@ -88,10 +99,16 @@ def show(df: pd.DataFrame, *, digits: int = 4) -> None:
     renders, and ``text/plain``, exactly the text ``print(format_table(df))`` prints (without
     its final newline); nbval compares both. A chapter cell calls ``show(table)`` where it
     printed ``format_table(table)`` and displayed the frame.
+
+    ``notes`` names a column of texts shown as numbered footnotes below the table, the column
+    holding their numbers (``[1]`` ...); it is left out where no row has a text.
     """
     from IPython.display import display
 
-    display({"text/plain": format_table(df), "text/html": html_table(df, digits=digits)}, raw=True)
+    body, footnotes = _footnoted(df, notes) if notes else (df, [])
+    text = _with_footnotes(format_table(body), footnotes)
+    page = html_table(body, digits=digits, notes=footnotes)
+    display({"text/plain": text, "text/html": page}, raw=True)
 
 
 def show_paper(df: pd.DataFrame, name: str | None = None) -> None:
