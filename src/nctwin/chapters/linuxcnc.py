@@ -343,8 +343,9 @@ def planner_numbers(rules: pd.DataFrame, fit_limits: pd.DataFrame) -> dict[str, 
         "own_worst_signed": own.err_pct[worst],
         "own_worst_program": own.program[worst],
     }
-    for group, errs in own.groupby("set").abs_err:
-        out[f"own_{group}_median"], out[f"own_{group}_worst"] = errs.median(), errs.max()
+    for row in method_summary(own, by=["set"]).itertuples():
+        out[f"own_{row.set}_median"] = row.median_abs_err_pct
+        out[f"own_{row.set}_worst"] = row.worst_abs_err_pct
     cam = rules[rules.set == "cam"]
     by_mode = cam.groupby(["rules", "mode"]).abs_err.max()
     out["no_kinks_g61_worst"] = by_mode[("no kinks", "G61")]
@@ -357,9 +358,9 @@ def planner_numbers(rules: pd.DataFrame, fit_limits: pd.DataFrame) -> dict[str, 
     for (axis, limit), row in fit.iterrows():
         name = {"acceleration_mm_s2": "acc", "velocity_mm_s": "vel"}[limit]
         for col in ("fitted", "profile", "start"):
-            out[f"fit_{axis}_{name}_{col}"] = float(row[col])
+            out[f"fit_{axis}_{name}_{col}"] = row[col]
     acc = fit.xs("acceleration_mm_s2", level="limit")
-    out["fit_acc_worst_pct"] = float((100 * (acc.fitted / acc.profile - 1)).abs().max())
+    out["fit_acc_worst_pct"] = (100 * (acc.fitted / acc.profile - 1)).abs().max()
     return {k: v if isinstance(v, str) else float(v) for k, v in out.items()}
 
 
