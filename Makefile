@@ -23,14 +23,8 @@ MATHJAX_DIR     := book/_vendor/mathjax
 NPM_CACHE       := build/npm
 CHROMIUM        ?= /usr/bin/chromium
 HTML_DIR        := book/_build/html
-# Processes of the unit tests that do not run LinuxCNC, and of nbval's notebooks that do not
-# (pytest-xdist); CI has 2 cores.
+# Processes of the unit tests that do not run LinuxCNC (pytest-xdist); CI has 2 cores.
 TEST_WORKERS    ?= 2
-# Executed notebooks that run LinuxCNC live: nbval runs them alone, before the others.
-NB_LIVE         := book/notebooks/linuxcnc_real_kernel.ipynb
-# The others, longest first (a notebook per process: the long ones start first).
-NB_LONGEST      := chien2023_bilstm zhang2023_step_error denkena2020_force_lstm sun2022_axis_nn \
-                   nist_hurco_real_machine
 
 # Source notebooks and the executed copies the book renders (committed).
 NOTEBOOKS := $(sort $(wildcard notebooks/*.ipynb))
@@ -325,28 +319,19 @@ chapter-runs: venv | $(EXECUTED)
 
 # nbval re-executes the notebooks in the environment papermill executed them in (inline figures,
 # no progress bars on stderr): a checked cell whose training outlasts the bar's delay would
-# otherwise print to stderr, which its executed copy does not have. The notebooks that run
-# LinuxCNC live go first, alone (a live run is timed against the servo thread; they also leave
-# the LinuxCNC chapter's networks in the cache); the others then run on TEST_WORKERS processes, a
-# notebook per process, its cells in order (--dist loadfile): their parallel cells leave a core
-# idle at their ends, which another notebook fills. The re-execution rewrites results/; nbval
-# fails if any file there differs afterwards from what it was before (a copy taken first, so
-# uncommitted work is compared with itself, and a fresh clone with the commit).
-NBVAL_ARGS := --nbval-lax --nbval-current-env -p no:cacheprovider --color=no --durations=20
+# otherwise print to stderr, which its executed copy does not have. Every cell's time goes to
+# build/nbval-cells.xml (JUnit XML; a notebook's time is the sum of its cells'). The
+# re-execution rewrites results/; nbval fails if any file there differs afterwards from what it
+# was before (a copy taken first, so uncommitted work is compared with itself, and a fresh clone
+# with the commit).
 nbval: venv | $(EXECUTED)
 	@shopt -s nullglob; nbs=(book/notebooks/*.ipynb); \
 	if [ $${#nbs[@]} -eq 0 ]; then echo "nbval: book/notebooks/ holds no executed notebook; skipped"; exit 0; fi; \
-	live=(); rest=(); \
-	for nb in $(foreach n,$(NB_LONGEST),book/notebooks/$(n).ipynb) "$${nbs[@]}"; do \
-	  [ -f "$$nb" ] || continue; case " $${live[*]} $${rest[*]} " in *" $$nb "*) continue;; esac; \
-	  case " $(NB_LIVE) " in *" $$nb "*) live+=("$$nb");; *) rest+=("$$nb");; esac; \
-	done; \
-	echo "nbval: $${live[*]}, then on $(TEST_WORKERS) processes: $${rest[*]}"; \
+	echo "nbval: $${nbs[*]}"; \
 	snap=build/results-before-nbval; rm -rf $$snap; mkdir -p build; cp -a results $$snap; status=0; \
-	export MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1; \
-	if [ $${#live[@]} -gt 0 ]; then $(PY) -m pytest $(NBVAL_ARGS) "$${live[@]}" || status=$$?; fi; \
-	if [ $${#rest[@]} -gt 0 ]; then $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile \
-	  $(NBVAL_ARGS) "$${rest[@]}" || status=$$?; fi; \
+	MPLBACKEND=$(NB_MPLBACKEND) TQDM_DISABLE=1 $(PY) -m pytest --nbval-lax --nbval-current-env \
+	  -p no:cacheprovider --color=no --durations=20 --junitxml=build/nbval-cells.xml \
+	  "$${nbs[@]}" || status=$$?; \
 	changed=$$(diff -rq $$snap results | sed -E \
 	  -e "s#^Files $$snap/(.*) and results/.* differ\$$#  results/\1#" \
 	  -e "s#^Only in $$snap/?(.*): (.*)\$$#  results/\1/\2 (no longer written)#" \
