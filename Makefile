@@ -232,7 +232,8 @@ STEP_SH := \
 # progress bars stay out of the executed notebooks.
 # Papermill runs through its Python API, not its command line, for two settings the command line
 # lacks: the kernel talks to papermill over IPC sockets (with TCP, ipykernel warns on every start
-# that the transport is not encrypted), and IPython prints tracebacks without colour codes.
+# that the transport is not encrypted; the sockets live in build/papermill/, so that a killed run
+# leaves none in the checkout), and IPython prints tracebacks without colour codes.
 NB_MPLBACKEND := module://matplotlib_inline.backend_inline
 NB_FORCE :=
 NB_VENV := venv
@@ -240,7 +241,7 @@ STEP :=
 PAPERMILL_PY := import sys, papermill; from traitlets.config import Config; \
   nb, out, cwd = sys.argv[1:]; \
   papermill.execute_notebook(nb, out, cwd=cwd, kernel_name="python3", progress_bar=False, \
-    config=Config(KernelManager={"transport": "ipc"}), \
+    config=Config(KernelManager={"transport": "ipc", "ip": "build/papermill/kernel-ipc"}), \
     extra_arguments=["--InteractiveShell.colors=nocolor"])
 book/notebooks/%.ipynb: $(NB_FORCE) | notebooks/%.ipynb $(NB_VENV)
 	@mkdir -p book/notebooks build/papermill
