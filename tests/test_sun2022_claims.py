@@ -54,3 +54,30 @@ def test_the_papers_own_numbers_pass_every_claim_it_makes():
     outcome["err_pct"][1, 2] = outcome["err_pct"][0, 2] + 0.5
     failing = {cid for cid, _, op, bar, value, _ in sc._specs() if not OPS[op](value(outcome), bar)}
     assert failing == {"model2_all_pockets", "model2_improves"}
+
+
+def test_the_ensembles_times_are_the_mean_of_its_seeds():
+    from nctwin.chapters.sun2022 import run_pocket
+    from nctwin.machine import load_profile
+
+    # eight copies of a 30 + 40 mm path at 600 mm/min, no rapid; two seeds predicting axis feeds
+    # (2, 4, 0) and (4, 4, 0) mm/s take 70 / sqrt(20) and 70 / sqrt(32) s on each (eq. 9-10)
+    run = run_pocket("G21 G91\nG1 X30 F600\nY40\n", 0, load_profile("sun2022_siemens"))
+    runs = [run] * 8
+    n = len(run.toolpath)
+    feeds = np.zeros((2, 1, 8 * n, 3))
+    feeds[0, 0] = (2.0, 4.0, 0.0)
+    feeds[1, 0] = (4.0, 4.0, 0.0)
+    pocket_s, g0_s = sc.seed_times(feeds, runs)
+    np.testing.assert_allclose(pocket_s[:, 0], [[70 / np.sqrt(20)] * 8, [70 / np.sqrt(32)] * 8])
+    np.testing.assert_array_equal(g0_s, 0.0)
+    measured = sc.measured_times(runs)
+    both = sc.outcome(pocket_s, g0_s, measured)
+    mean_s = 0.5 * (70 / np.sqrt(20) + 70 / np.sqrt(32))
+    np.testing.assert_allclose(both["err_pct"][0], abs(mean_s / run.measured_s - 1) * 100)
+    np.testing.assert_allclose(both["cam_err_pct"], abs(run.cam_s / run.measured_s - 1) * 100)
+    np.testing.assert_allclose(both["g0_err_s"], 0.0)
+    # one seed alone is a single network
+    first = sc.outcome(pocket_s[:1], g0_s[:1], measured)
+    single = abs(70 / np.sqrt(20) / run.measured_s - 1) * 100
+    np.testing.assert_allclose(first["err_pct"][0], single)

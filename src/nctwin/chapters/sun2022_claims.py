@@ -4,7 +4,7 @@ The conditions (:func:`paper_conditions`) are measured on the machine, the logge
 alone, before any network is trained: each pocket's CAD/CAM time and error against Table 3,
 pocket 1's cutter locations and the logger's records per second. The claims (:func:`claims`)
 are the paper's statements of Sec. 4 at their own levels, judged on the ensemble (the mean of
-the seeds' axis feeds through eq. 9-10), each with how many single networks pass and a
+the seeds' block times, eq. 9-10), each with how many single networks pass and a
 bootstrap interval over the seeds.
 """
 
@@ -30,10 +30,12 @@ __all__ = [
     "CL_TOL_PCT",
     "RATE_TOL_PCT",
     "claims",
+    "measured_times",
     "outcome",
     "paper_conditions",
     "paper_numbers",
     "seed_feeds",
+    "seed_times",
     "summary_value",
 ]
 
@@ -123,25 +125,72 @@ def seed_feeds(ensembles: dict[str, list[list[Trained]]], runs: list[PocketRun])
     Returns
     -------
     ndarray, shape (n_seeds, n_models, N, 3)
-        :func:`outcome` makes the ensemble's times of them.
+        :func:`seed_times` makes each seed's times of them.
     """
     per_model = [[np.concatenate(predict_all_feeds([m], runs)) for m in members]
                  for members in ensembles.values()]  # fmt: skip
     return np.stack(per_model, axis=1)
 
 
-def outcome(feeds: np.ndarray, runs: list[PocketRun]) -> dict[str, np.ndarray]:
-    """The errors the claims read, from the axis feeds of an ensemble's seeds, per model: each
-    seed's feeds give block times (eq. 9-10), the ensemble's block time is their mean
-    (:func:`~nctwin.chapters.sun2022.predict_times`).
+def seed_times(feeds: np.ndarray, runs: list[PocketRun]) -> tuple[np.ndarray, np.ndarray]:
+    """Each seed's predicted machining time per model and pocket (eq. 9-10, every block), and
+    over the rapids of pocket :data:`G0_POCKET`.
 
     Parameters
     ----------
     feeds : ndarray, shape (n_seeds, n_models, N, 3)
         Axis feeds at every cutter location of ``runs`` (concatenated), models in the order
-        of :func:`seed_feeds`; one seed for a single network.
+        of :func:`seed_feeds`.
     runs : list of PocketRun
         Pockets 1 to 8, in order.
+
+    Returns
+    -------
+    pocket_s : ndarray, shape (n_seeds, n_models, n_pockets)
+    g0_s : ndarray, shape (n_seeds, n_models)
+    """
+    split = np.cumsum([len(r.toolpath) for r in runs])[:-1]
+    n_seeds, n_models = feeds.shape[:2]
+    pocket_s = np.empty((n_seeds, n_models, len(runs)))
+    g0_s = np.empty((n_seeds, n_models))
+    rapid = runs[G0_POCKET - 1].toolpath.kind == MotionKind.RAPID
+    for s in range(n_seeds):
+        for m in range(n_models):
+            for k, (f, run) in enumerate(zip(np.split(feeds[s, m], split), runs, strict=True)):
+                t = sun.block_times_s(f, run.toolpath.lengths_mm, run.commanded_mm_s)
+                pocket_s[s, m, k] = t.sum()
+                if k + 1 == G0_POCKET:
+                    g0_s[s, m] = t[rapid].sum()
+    return pocket_s, g0_s
+
+
+def measured_times(runs: list[PocketRun]) -> dict[str, np.ndarray]:
+    """What :func:`outcome` compares with: ``measured_s`` and ``cam_s``, shape (n_pockets,),
+    the machine's and CAD/CAM's time per pocket; ``g0_s``, shape (), the machine's time on the
+    rapids of pocket :data:`G0_POCKET`."""
+    run = runs[G0_POCKET - 1]
+    rapid = np.flatnonzero(run.toolpath.kind == MotionKind.RAPID)
+    return {
+        "measured_s": np.array([r.measured_s for r in runs]),
+        "cam_s": np.array([r.cam_s for r in runs]),
+        "g0_s": np.asarray(np.isin(run.motion.block, rapid).sum() * run.motion.period_s),
+    }
+
+
+def outcome(
+    pocket_s: np.ndarray, g0_s: np.ndarray, measured: dict[str, np.ndarray]
+) -> dict[str, np.ndarray]:
+    """The errors the claims read, for the ensemble of the seeds whose :func:`seed_times` are
+    given (one seed: a single network). The ensemble's block time is the mean of its seeds'
+    (:func:`~nctwin.chapters.sun2022.predict_times`), so its time over any set of blocks is the
+    mean of theirs.
+
+    Parameters
+    ----------
+    pocket_s : ndarray, shape (n_seeds, n_models, n_pockets)
+    g0_s : ndarray, shape (n_seeds, n_models)
+    measured : dict
+        :func:`measured_times` of the pockets.
 
     Returns
     -------
@@ -150,22 +199,11 @@ def outcome(feeds: np.ndarray, runs: list[PocketRun]) -> dict[str, np.ndarray]:
         per pocket; ``cam_err_pct``: shape (n_pockets,); ``g0_err_s``: shape (n_models,), each
         model's predicted minus measured time over the rapids of pocket :data:`G0_POCKET`.
     """
-    split = np.cumsum([len(r.toolpath) for r in runs])[:-1]
-    n_models = feeds.shape[1]
-    err = np.empty((n_models, len(runs)))
-    g0 = np.empty(n_models)
-    for m in range(n_models):
-        per_seed = [np.split(f, split) for f in feeds[:, m]]
-        for k, run in enumerate(runs):
-            t = np.mean([sun.block_times_s(f[k], run.toolpath.lengths_mm, run.commanded_mm_s)
-                         for f in per_seed], axis=0)  # fmt: skip
-            err[m, k] = error_pct(float(t.sum()), run.measured_s)
-            if k + 1 == G0_POCKET:
-                rapid = run.toolpath.kind == MotionKind.RAPID
-                on_rapid = np.isin(run.motion.block, np.flatnonzero(rapid))
-                g0[m] = t[rapid].sum() - on_rapid.sum() * run.motion.period_s
-    cam = np.array([error_pct(r.cam_s, r.measured_s) for r in runs])
-    return {"err_pct": err, "cam_err_pct": cam, "g0_err_s": g0}
+    return {
+        "err_pct": error_pct(pocket_s.mean(axis=0), measured["measured_s"]),
+        "cam_err_pct": error_pct(measured["cam_s"], measured["measured_s"]),
+        "g0_err_s": g0_s.mean(axis=0) - measured["g0_s"],
+    }
 
 
 def _specs() -> list[tuple[str, str, str, float, Callable[[dict], float], tuple[int, ...]]]:
@@ -222,19 +260,18 @@ def claims(
     -------
     list of Claim
     """
-    cache: dict[tuple[int, ...], dict[str, np.ndarray]] = {}
+    pocket_s, g0_s = seed_times(feeds, runs)
+    measured = measured_times(runs)
 
     def ensemble_of(rows: np.ndarray) -> dict[str, np.ndarray]:
-        """:func:`outcome` of the ensemble of the seeds whose indices are ``rows[:, 0]``, once
-        per set of seeds (the bootstrap draws the same sets for every claim)."""
-        key = tuple(sorted(int(i) for i in rows[:, 0]))
-        if key not in cache:
-            cache[key] = outcome(feeds[list(key)], runs)
-        return cache[key]
+        """:func:`outcome` of the ensemble of the seeds whose indices are ``rows[:, 0]`` (the
+        bootstrap hands them over as floats)."""
+        seeds = rows[:, 0].astype(int)
+        return outcome(pocket_s[seeds], g0_s[seeds], measured)
 
     index = np.arange(len(feeds))[:, None]  # the bootstrap resamples seeds by their index
-    ensemble = outcome(feeds, runs)
-    singles = [outcome(feeds[[s]], runs) for s in range(len(feeds))]
+    ensemble = ensemble_of(index)
+    singles = [ensemble_of(index[[s]]) for s in range(len(feeds))]
     out = []
     for cid, text, op, bar, value, pockets in _specs():
         claim = Claim(cid, f"Sun et al. 2022, {text}", value(ensemble), op, bar,
