@@ -419,7 +419,10 @@ class _AutogradRun:
         if cfg.optimiser == "sgd":
             self.optimiser = _SGD(model.parameters(), cfg.learning_rate, cfg.momentum)
         else:
-            self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate)
+            # foreach: the parameters in one call per operation, bit for bit the per-tensor
+            # loop (torch's default on the CPU), a sixth faster on a small network's step
+            self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate,
+                                              foreach=True)  # fmt: skip
 
     def epoch(self, windows: np.ndarray, *, stop_if_nan: bool = False) -> float:
         """Steps on ``windows`` in batches of ``batch_size``; the mean of the batch losses,
