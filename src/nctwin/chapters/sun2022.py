@@ -317,11 +317,14 @@ def train_ensembles(
         ``(model name, target) -> [per seed: [X, Y, Z network]]``.
     """
     keys = [(name, target, seed) for name in MODELS for target in targets for seed in seeds]
-    tasks = [_task_args(runs, MODELS[name], target, seed, 4) for name, target, seed in keys]
-    trained = run_tasks(_train_task, tasks, n_jobs=n_jobs)
+    # the models with the most training rows first, so that no long task runs alone at the end
+    rows = {name: sum(len(runs[p].toolpath) for p in pockets) for name, pockets in MODELS.items()}
+    order = sorted(keys, key=lambda key: -rows[key[0]])
+    tasks = [_task_args(runs, MODELS[name], target, seed, 4) for name, target, seed in order]
+    trained = dict(zip(order, run_tasks(_train_task, tasks, n_jobs=n_jobs), strict=True))
     out: dict[tuple[str, str], list[list[Trained]]] = {}
-    for (name, target, _), models in zip(keys, trained, strict=True):
-        out.setdefault((name, target), []).append(models)
+    for name, target, seed in keys:
+        out.setdefault((name, target), []).append(trained[name, target, seed])
     return out
 
 
