@@ -57,6 +57,7 @@ from .estimate import block_overlap, cam, kernel
 from .estimate.blend_planner import blend_planner
 from .identify import at_rapid_override, fit_block_overlap, fit_fir, fit_planner
 from .machine import Machine, Profile, write_control
+from .runner import run_tasks
 from .runtimes import ProgramLines, RunTimes, first_changes, first_m6, motion_window
 from .toolpath import Toolpath
 
@@ -384,7 +385,8 @@ def held_out_predictions(
     n_jobs: int = 2,
 ) -> tuple[pd.DataFrame, dict[str, Calibration]]:
     """Each program's runs predicted (:func:`predict_runs`) by a calibration on the other
-    programs' runs (and on the other programs' rows of ``rapids``).
+    programs' runs (and on the other programs' rows of ``rapids``), ``n_jobs`` calibrations at
+    a time (:func:`nctwin.runner.run_tasks`).
 
     Returns
     -------
@@ -394,14 +396,24 @@ def held_out_predictions(
     calibrations : dict of str to Calibration
         The calibration each program was predicted by, by file name.
     """
-    parts, cals = [], {}
-    for file in sorted({r.program for r in times}):
-        train = [r for r in times if r.program != file]
-        other = None if rapids is None else rapids[rapids["program"] != file]
-        cals[file] = cal = calibrate(name, train, programs, other, n_jobs=n_jobs)
+    files = sorted({r.program for r in times})
+    tasks = [
+        (name, [r for r in times if r.program != file], programs,
+         None if rapids is None else rapids[rapids["program"] != file])
+        for file in files
+    ]  # fmt: skip
+    # a fold per worker, its grid search in series: the planner's fit is serial, the folds not
+    cals = dict(zip(files, run_tasks(_calibrate_fold, tasks, n_jobs=n_jobs), strict=True))
+    parts = []
+    for file, cal in cals.items():
         pred = predict_runs(cal, [r for r in times if r.program == file], programs)
         parts.append(pred.assign(chosen=pred["method"] == cal.best))
     return pd.concat(parts, ignore_index=True), cals
+
+
+def _calibrate_fold(name, times, programs, rapids) -> Calibration:
+    """:func:`calibrate` in one process (what a worker of :func:`held_out_predictions` runs)."""
+    return calibrate(name, times, programs, rapids, n_jobs=1)
 
 
 def leave_one_program_out(

@@ -198,7 +198,6 @@ def split_table() -> pd.DataFrame:
 
 
 @functools.cache
-@functools.cache
 def _held_out(name: str) -> tuple[pd.DataFrame, dict[str, Calibration]]:
     times, programs, rapids = _machine(name)
     return held_out_predictions(name, times, programs, rapids)
