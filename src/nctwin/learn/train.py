@@ -418,11 +418,8 @@ class _AutogradRun:
             self.validation = x, y, mask.to(torch.float32)
         if cfg.optimiser == "sgd":
             self.optimiser = _SGD(model.parameters(), cfg.learning_rate, cfg.momentum)
-        else:
-            # foreach: the parameters in one call per operation, bit for bit the per-tensor
-            # loop (torch's default on the CPU), a sixth faster on a small network's step
-            self.optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate,
-                                              foreach=True)  # fmt: skip
+        else:  # foreach: bit for bit the per-tensor loop (the CPU default), and faster
+            self.optimiser = torch.optim.Adam(model.parameters(), cfg.learning_rate, foreach=True)
 
     def epoch(self, windows: np.ndarray, *, stop_if_nan: bool = False) -> float:
         """Steps on ``windows`` in batches of ``batch_size``; the mean of the batch losses,
