@@ -209,3 +209,20 @@ def test_stacked_lstm_with_dropout_and_unchanged_default_keys():
         ModelConfig(dropout=1.0)
     with pytest.raises(ValueError, match="lstm_layers"):
         ModelConfig(lstm_layers=0)
+
+
+def test_fit_seeds_takes_each_jobs_seeds():
+    from nctwin.learn.seeds import fit_seeds
+
+    xs, ys = _data()
+    cfg_m = ModelConfig(kind="mlp", n_inputs=2, hidden=4)
+    jobs = {"a": (cfg_m, CFG, xs, ys), "b": (cfg_m, CFG, xs[:4], ys[:4])}
+    each = fit_seeds(jobs, {"a": [2], "b": [5, 3]}, n_jobs=1)
+    assert list(each) == ["a", "b"]
+    assert [[n.train_config.seed for n in nets] for nets in each.values()] == [[2], [5, 3]]
+    # the same networks as one seed list per call (the cache is keyed by job and seed)
+    b = fit_seeds({"b": jobs["b"]}, [5, 3], n_jobs=1)["b"]
+    for x, y in zip(each["b"], b, strict=True):
+        assert x.path == y.path
+        sx, sy = x.model.state_dict(), y.model.state_dict()
+        assert all(torch.equal(sx[k], sy[k]) for k in sx)

@@ -3,7 +3,7 @@ learned claim (five or more, with their spread)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -21,7 +21,7 @@ def _fit(model_config: ModelConfig, cfg: TrainConfig, xs, ys, name: str) -> Trai
 
 def fit_seeds(
     jobs: dict[str, tuple[ModelConfig, TrainConfig, Sequence[np.ndarray], Sequence[np.ndarray]]],
-    seeds: Sequence[int],
+    seeds: Sequence[int] | Mapping[str, Sequence[int]],
     *,
     n_jobs: int = 2,
 ) -> dict[str, list[Trained]]:
@@ -33,19 +33,25 @@ def fit_seeds(
     ----------
     jobs : dict
         ``name -> (model_config, train_config, xs, ys)``; the seed of ``train_config`` is
-        replaced by each of ``seeds``. List the slowest first: the runner hands out tasks in
-        order.
-    seeds : sequence of int
+        replaced by each of the job's seeds. List the slowest first: the runner hands out tasks
+        in order.
+    seeds : sequence of int, or dict
+        The seeds of every job, or ``name -> seeds`` of each (one call, so that no worker waits
+        for another's last network between groups of jobs).
     n_jobs : int
         Parallel trainings (each on one thread).
 
     Returns
     -------
     dict
-        ``name -> [Trained per seed]``, in the order of ``seeds``.
+        ``name -> [Trained per seed]``, in the order of its seeds.
     """
+    of = seeds if isinstance(seeds, Mapping) else dict.fromkeys(jobs, seeds)
     tasks = [(name, cfg_m, replace(cfg, seed=s), xs, ys)
-             for name, (cfg_m, cfg, xs, ys) in jobs.items() for s in seeds]  # fmt: skip
+             for name, (cfg_m, cfg, xs, ys) in jobs.items() for s in of[name]]  # fmt: skip
     out = run_tasks(_fit, ((m, c, x, y, f"{n}_seed{c.seed}") for n, m, c, x, y in tasks),
                     n_jobs=n_jobs, desc="networks")  # fmt: skip
-    return {name: out[i * len(seeds) : (i + 1) * len(seeds)] for i, name in enumerate(jobs)}
+    nets: dict[str, list[Trained]] = {name: [] for name in jobs}
+    for (name, *_), net in zip(tasks, out, strict=True):
+        nets[name].append(net)
+    return nets
