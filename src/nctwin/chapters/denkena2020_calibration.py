@@ -15,6 +15,7 @@ import pandas as pd
 
 from ..methods import denkena2020 as fm
 from ..physics import drives
+from ..runner import run_tasks
 from .denkena2020 import fit_force_model, reconstruct
 from .denkena2020_bench import TOOL, Process, process_windows, run_air_moves, run_processes
 
@@ -103,6 +104,7 @@ def calibrate_bench(
     *,
     duration_s: float,
     seed: int,
+    n_jobs: int = 2,
 ) -> pd.DataFrame:
     """The model's RMSE over the cut of :func:`calibration_processes` for each candidate
     compliance, beside the paper's.
@@ -119,6 +121,8 @@ def calibrate_bench(
         Table 1.
     duration_s : float
     seed : int
+    n_jobs : int
+        Candidates run at a time (:func:`nctwin.runner.run_tasks`).
 
     Returns
     -------
@@ -128,28 +132,37 @@ def calibrate_bench(
         which the standing X axis reads a velocity, and the paper's ramp values and groove range.
     """
     procs = calibration_processes(paper2, grid, duration_s=duration_s)
+    tasks = [(machine, c, procs, duration_s, seed) for c in candidates]
+    rows = pd.DataFrame(run_tasks(_candidate_row, tasks, n_jobs=n_jobs))
     ramp = paper2[paper2["process"] == "ramp milling"].set_index("axis")["model_rmse_n"]
-    rows = []
-    for mass, stiffness, ratio in candidates:
-        m = with_compliance(machine, mass, stiffness, ratio)
-        rec = run_processes(procs, m, duration_s=duration_s, seed=seed, n_jobs=1)
-        targets = fm.target_forces(rec.force_n, m.record_rate_hz)
-        windows = process_windows(procs, m, duration_s=duration_s)
-        model, _ = fit_force_model(run_air_moves(m, seed=seed),
-                                   np.array([a.km_n_a for a in m.axes]))  # fmt: skip
-        err = np.empty((len(procs), 2))
-        for p in procs:
-            cut = windows.cutting[p.index]
-            diff = reconstruct(model, rec.inputs[p.index])[cut, :2] - targets[p.index, cut, :2]
-            err[p.index] = np.sqrt(np.mean(diff**2, axis=0))
-        cut0 = windows.cutting[0]
-        reads = np.abs(rec.inputs[0, cut0, 3]) >= 0.5 * m.velocity_resolution_mm_s
-        rows.append({"mass_kg": mass, "stiffness_n_mm": stiffness, "damping_ratio": ratio,
-                     "corner_hz": np.sqrt(stiffness * 1e3 / mass) / (2.0 * np.pi),
-                     "ramp_model_rmse_x_n": err[0, 0], "ramp_model_rmse_y_n": err[0, 1],
-                     "groove_model_rmse_n": float(err[1:].mean()),
-                     "ramp_x_reads_v_pct": 100.0 * float(reads.mean()),
-                     "paper_ramp_x_n": float(ramp["X"]), "paper_ramp_y_n": float(ramp["Y"]),
-                     "paper_groove_min_n": float(figures["model_rmse_n"].min()),
-                     "paper_groove_max_n": float(figures["model_rmse_n"].max())})  # fmt: skip
-    return pd.DataFrame(rows)
+    return rows.assign(paper_ramp_x_n=float(ramp["X"]), paper_ramp_y_n=float(ramp["Y"]),
+                       paper_groove_min_n=float(figures["model_rmse_n"].min()),
+                       paper_groove_max_n=float(figures["model_rmse_n"].max()))  # fmt: skip
+
+
+def _candidate_row(
+    machine: drives.FeedDriveMachine,
+    candidate: tuple[float, float, float],
+    procs: list[Process],
+    duration_s: float,
+    seed: int,
+) -> dict:
+    """One row of :func:`calibrate_bench` without the paper's columns (what a worker runs)."""
+    mass, stiffness, ratio = candidate
+    m = with_compliance(machine, mass, stiffness, ratio)
+    rec = run_processes(procs, m, duration_s=duration_s, seed=seed, n_jobs=1)
+    targets = fm.target_forces(rec.force_n, m.record_rate_hz)
+    windows = process_windows(procs, m, duration_s=duration_s)
+    model, _ = fit_force_model(run_air_moves(m, seed=seed), np.array([a.km_n_a for a in m.axes]))
+    err = np.empty((len(procs), 2))
+    for p in procs:
+        cut = windows.cutting[p.index]
+        diff = reconstruct(model, rec.inputs[p.index])[cut, :2] - targets[p.index, cut, :2]
+        err[p.index] = np.sqrt(np.mean(diff**2, axis=0))
+    cut0 = windows.cutting[0]
+    reads = np.abs(rec.inputs[0, cut0, 3]) >= 0.5 * m.velocity_resolution_mm_s
+    return {"mass_kg": mass, "stiffness_n_mm": stiffness, "damping_ratio": ratio,
+            "corner_hz": np.sqrt(stiffness * 1e3 / mass) / (2.0 * np.pi),
+            "ramp_model_rmse_x_n": err[0, 0], "ramp_model_rmse_y_n": err[0, 1],
+            "groove_model_rmse_n": float(err[1:].mean()),
+            "ramp_x_reads_v_pct": 100.0 * float(reads.mean())}  # fmt: skip
