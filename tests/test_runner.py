@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -18,6 +20,16 @@ def _square(x: int) -> int:
 def test_results_come_back_in_the_order_of_the_tasks():
     assert run_tasks(_square, [(k,) for k in range(7)], n_jobs=2) == [k * k for k in range(7)]
     assert run_tasks(_square, [(3,)], n_jobs=1, threads=True) == [9]
+
+
+def _pid(_: int) -> int:
+    return os.getpid()
+
+
+def test_one_job_runs_here_whatever_the_environment_says(monkeypatch):
+    # a task that runs tasks of its own inside a worker opens no pool and no cluster client
+    monkeypatch.setenv(SCHEDULER_ENV, "tcp://192.0.2.1:8786")  # nothing listens there
+    assert run_tasks(_pid, [(0,), (1,)], n_jobs=1) == [os.getpid()] * 2
 
 
 @pytest.mark.parametrize("n_jobs", [0, -1, 1.5, True])

@@ -10,7 +10,9 @@ runs does not change its result: the results are bit-identical either way (a tes
 against a ``LocalCluster``).
 
 Tasks that drive local processes (LinuxCNC recordings) ask for ``threads=True``: they run in
-threads on this machine, whatever the environment says.
+threads on this machine, whatever the environment says. ``n_jobs=1`` runs the tasks one after the
+other in the calling process, whatever the environment says: a task that runs tasks of its own
+(a calibration fold inside a worker) asks for that, and never opens a second pool or a client.
 """
 
 from __future__ import annotations
@@ -52,7 +54,8 @@ def run_tasks(
     tasks : iterable of tuples
         The positional arguments of each call.
     n_jobs : int
-        Local workers, at least 1 (ignored on a Dask cluster, which uses its own workers).
+        Local workers, at least 1; 1 runs the tasks here, in order (on a Dask cluster any larger
+        number is ignored: the cluster uses its own workers).
     threads : bool
         Run in local threads (tasks that drive local processes), never on a cluster.
     desc : str, optional
@@ -70,6 +73,8 @@ def run_tasks(
     """
     check_int("n_jobs", n_jobs, 1)
     tasks = list(tasks)
+    if n_jobs == 1:
+        return _collect((fn(*args) for args in tasks), len(tasks), desc)
     jobs = (delayed(fn)(*args) for args in tasks)
     address = None if threads else scheduler_address()
     if address is None:
