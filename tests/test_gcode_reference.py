@@ -65,10 +65,11 @@ def test_fanuc_g91_g28_z0_before_a_tool_change():
     assert_moves(tp, expected)
     assert tp.line.tolist() == [5, 6, 7, 7, 10]
     words = [(f"{e['word']}{e['value']:g}", int(e["block"])) for e in tp.events]
+    # G43: the G49 of N110, a tool length offset (OFFSET_EVENTS)
     assert words == [
         ("G43", 0), ("S750", 0), ("M3", 0), ("M8", 1), ("M9", 2), ("M1", 4), ("T15", 4),
         ("M6", 4), ("M30", 5),
-    ]  # fmt: skip (G43: the G49 of N110, a tool length offset, OFFSET_EVENTS)
+    ]  # fmt: skip
     # LinuxCNC's reference point by default: machine zero
     assert parse(text, reader="native").end_mm[3].tolist() == [25.4, 50.8, 0.0]
 

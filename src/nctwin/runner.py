@@ -13,11 +13,19 @@ Tasks that drive local processes (LinuxCNC recordings) ask for ``threads=True``:
 threads on this machine, whatever the environment says. ``n_jobs=1`` runs the tasks one after the
 other in the calling process, whatever the environment says: a task that runs tasks of its own
 (a calibration fold inside a worker) asks for that, and never opens a second pool or a client.
+
+Local workers are joblib's reused loky processes. loky retires a worker whose memory has grown by
+300 MB since its first task and starts another in its place (a network's training grows a worker
+that first ran a simulation by about that much: freed memory stays with the process), with a
+``UserWarning`` that it "stopped while some jobs were given to the executor". The tasks keep no
+state between calls, so nothing but the new worker's start is lost; :func:`run_tasks` keeps that
+one warning out of its caller's output.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
@@ -30,6 +38,10 @@ __all__ = ["SCHEDULER_ENV", "run_tasks", "scheduler_address"]
 
 #: Environment variable naming a Dask scheduler to run tasks on.
 SCHEDULER_ENV = "NCTWIN_DASK_SCHEDULER"
+
+
+#: The start of loky's warning when it replaces a worker (see the module docstring).
+_WORKER_REPLACED = "A worker stopped while some jobs were given to the executor"
 
 
 def scheduler_address() -> str | None:
@@ -80,7 +92,9 @@ def run_tasks(
     if address is None:
         backend = "threading" if threads else "loky"
         parallel = Parallel(n_jobs=n_jobs, backend=backend, return_as="generator")
-        return _collect(parallel(jobs), len(tasks), desc)
+        with warnings.catch_warnings():  # loky's manager thread warns through the same filters
+            warnings.filterwarnings("ignore", _WORKER_REPLACED, UserWarning)
+            return _collect(parallel(jobs), len(tasks), desc)
     try:  # only where a cluster is asked for: a slow import, and an optional extra
         from dask.distributed import Client
     except ImportError:
