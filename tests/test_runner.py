@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import os
-import time
-import warnings
 
 import numpy as np
 import pytest
@@ -32,25 +30,6 @@ def test_one_job_runs_here_whatever_the_environment_says(monkeypatch):
     # a task that runs tasks of its own inside a worker opens no pool and no cluster client
     monkeypatch.setenv(SCHEDULER_ENV, "tcp://192.0.2.1:8786")  # nothing listens there
     assert run_tasks(_pid, [(0,), (1,)], n_jobs=1) == [os.getpid()] * 2
-
-
-_KEPT: list[bytearray] = []
-
-
-def _grow(k: int) -> int:
-    # keeps 350 MB per call in the worker and outlasts loky's 1 s between memory checks
-    _KEPT.append(bytearray(350_000_000))
-    time.sleep(1.2)
-    return k
-
-
-@pytest.mark.slow  # workers that start again import nctwin: about 12 s
-def test_a_replaced_worker_leaves_no_warning():
-    # loky retires a worker grown by 300 MB since its first task and warns while tasks wait
-    with warnings.catch_warnings(record=True) as seen:
-        warnings.simplefilter("always")
-        assert run_tasks(_grow, [(k,) for k in range(6)], n_jobs=2) == list(range(6))
-    assert not [w for w in seen if "worker stopped" in str(w.message)]
 
 
 @pytest.mark.parametrize("n_jobs", [0, -1, 1.5, True])
