@@ -125,6 +125,14 @@ def test_main_writes_the_page(book, tmp_path, monkeypatch, capsys):
     assert "3 claims of 2 chapters" in capsys.readouterr().out
 
 
+@pytest.mark.parametrize("argv", [["--help"], ["-o", "x.md"], ["a.md", "b.md"]])
+def test_the_command_line_writes_no_file_named_by_an_option(argv, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        verdicts.main(argv)
+    assert not list(tmp_path.iterdir())
+
+
 def test_the_repository_page_renders():
     """Every committed claims.json has its notebook, and every claim a row."""
     root = verdicts.paths.repo_root()

@@ -19,6 +19,7 @@ notebook's ``report_claims`` cell.
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import re
@@ -347,9 +348,14 @@ def main(argv: list[str] | None = None) -> int:
     """``python -m nctwin.report.verdicts OUT.md``: write the page (default book/verdicts.md)
     and the chapters' statuses in the book's intro (``intro.md`` beside the page, where it
     holds :data:`INTRO_MARKERS`)."""
-    argv = sys.argv[1:] if argv is None else argv
+    parser = argparse.ArgumentParser(
+        prog="python -m nctwin.report.verdicts",
+        description="Write the book's Verdicts page from results/*/claims.json.",
+    )
+    parser.add_argument("out", nargs="?", type=Path, help="the page (default book/verdicts.md)")
+    args = parser.parse_args(argv)
     root = paths.repo_root()
-    out = Path(argv[0]) if argv else root / "book" / "verdicts.md"
+    out = args.out or root / "book" / "verdicts.md"
     chapters = chapters_in_order(
         root / "book" / "_toc.yml", paths.results_dir(), root / "notebooks"
     )
