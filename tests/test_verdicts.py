@@ -119,7 +119,7 @@ def test_main_writes_the_page(book, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("NCTWIN_RESULTS", str(book / "results"))
     (book / "book").mkdir()
     (book / "book" / "_toc.yml").write_text((book / "_toc.yml").read_text())
-    out = tmp_path / "verdicts.md"
+    out = tmp_path / "new" / "verdicts.md"  # a folder that does not exist yet
     assert verdicts.main([str(out)]) == 0
     assert out.read_text().startswith("# Verdicts\n")
     assert "3 claims of 2 chapters" in capsys.readouterr().out

@@ -359,6 +359,7 @@ def main(argv: list[str] | None = None) -> int:
     chapters = chapters_in_order(
         root / "book" / "_toc.yml", paths.results_dir(), root / "notebooks"
     )
+    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(render(chapters), encoding="utf-8")
     intro = out.parent / "intro.md"
     if intro.is_file() and INTRO_MARKERS[0] in (text := intro.read_text(encoding="utf-8")):
