@@ -90,6 +90,19 @@ def test_chapter_runner_names_what_does_not_exist(capsys):
     assert capsys.readouterr().err == "chapter: PROGRAM=absent.ngc: no such file\n"
 
 
+def test_chapter_runner_refuses_a_parameter_the_chapter_does_not_take(capsys, tmp_path):
+    assert chapter.main(["lee2022_block_overlap", "-p", "sead", "3"]) == 2
+    assert capsys.readouterr().err == (
+        "chapter: -p sead = 3: lee2022_block_overlap takes no such parameter; its parameters "
+        "are out_of_domain, program\n"
+    )
+    program = tmp_path / "part.ngc"
+    program.write_text("G1 X1 F100\n")
+    assert chapter.main(["your_own_toolpath", "--program", str(program)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("chapter: PROGRAM = ") and err.endswith("it has none\n")
+
+
 def test_chapter_runner_finds_a_chapter_by_stem_or_path():
     root = repo_root()
     by_stem = chapter.resolve_notebook("lee2022_block_overlap", root)

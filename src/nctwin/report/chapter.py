@@ -9,7 +9,8 @@ and writes the executed notebook and its HTML to ``DIR/<stem>.ipynb`` and ``DIR/
 never touched. The networks come from the chapter's cache in ``data/cache/`` (a chapter that has
 not run before trains them first).
 
-A notebook or program that does not exist is named in one line before anything runs (exit 2); a
+A notebook or program that does not exist, or a parameter the chapter does not take, is named in
+one line before anything runs (exit 2); a
 chapter that fails names its partly executed notebook (exit 1).
 """
 
@@ -22,7 +23,7 @@ from pathlib import Path
 
 from .. import paths
 
-__all__ = ["execute", "main", "resolve_notebook"]
+__all__ = ["check_names", "execute", "main", "resolve_notebook"]
 
 #: The kernel's figures: inline (the Makefile's notebooks use the same backend).
 NB_MPLBACKEND = "module://matplotlib_inline.backend_inline"
@@ -85,6 +86,25 @@ def execute(notebook: Path, out_dir: Path, parameters: dict, root: Path) -> Path
     return html
 
 
+def check_names(notebook: Path, parameters: dict) -> None:
+    """Refuse, before anything runs, a parameter the chapter's parameters cell does not set.
+
+    Raises
+    ------
+    ValueError
+        Naming the first unknown parameter, its value and the chapter's parameters.
+    """
+    import papermill
+
+    known = list(papermill.inspect_notebook(str(notebook)))
+    for name, value in parameters.items():
+        if name not in known:
+            flag = "PROGRAM" if name == "program" else f"-p {name}"
+            allowed = f"its parameters are {', '.join(known)}" if known else "it has none"
+            raise ValueError(f"{flag} = {value!r}: {notebook.stem} takes no such parameter; "
+                             f"{allowed}")  # fmt: skip
+
+
 def _value(text: str) -> int | float | str:
     for kind in (int, float):
         try:
@@ -119,6 +139,7 @@ def main(argv: list[str] | None = None) -> int:
             if not program.is_file():
                 raise ValueError(f"PROGRAM={args.program}: no such file")
             parameters["program"] = str(program)
+        check_names(notebook, parameters)
     except ValueError as exc:
         print(f"chapter: {exc}", file=sys.stderr)
         return 2
