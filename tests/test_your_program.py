@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import warnings
+
+import nbformat
 import numpy as np
 import pandas as pd
 import pytest
@@ -101,6 +104,22 @@ def test_chapter_runner_refuses_a_parameter_the_chapter_does_not_take(capsys, tm
     assert chapter.main(["your_own_toolpath", "--program", str(program)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("chapter: PROGRAM = ") and err.endswith("it has none\n")
+
+
+def test_the_chapters_html_is_written_without_warnings(tmp_path):
+    # myst-nb's glue(..., display=False) leaves a record that nbconvert cannot show
+    nb = nbformat.v4.new_notebook()
+    cell = nbformat.v4.new_code_cell("glue('x', 1.0, display=False)")
+    cell.outputs = [nbformat.v4.new_output(
+        "display_data", data={"application/papermill.record/text/plain": "1.0"},
+        metadata={"scrapbook": {"name": "x"}})]  # fmt: skip
+    nb.cells = [cell]
+    executed = tmp_path / "chapter.ipynb"
+    nbformat.write(nb, executed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        html = chapter.write_html(executed)
+    assert html == tmp_path / "chapter.html" and "<html" in html.read_text()
 
 
 def test_chapter_runner_finds_a_chapter_by_stem_or_path():

@@ -19,11 +19,12 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from .. import paths
 
-__all__ = ["check_names", "execute", "main", "resolve_notebook"]
+__all__ = ["check_names", "execute", "main", "resolve_notebook", "write_html"]
 
 #: The kernel's figures: inline (the Makefile's notebooks use the same backend).
 NB_MPLBACKEND = "module://matplotlib_inline.backend_inline"
@@ -55,9 +56,7 @@ def execute(notebook: Path, out_dir: Path, parameters: dict, root: Path) -> Path
     pathlib.Path
         The HTML file.
     """
-    import nbformat
     import papermill
-    from nbconvert import HTMLExporter
     from traitlets.config import Config
 
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -80,7 +79,17 @@ def execute(notebook: Path, out_dir: Path, parameters: dict, root: Path) -> Path
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
-    body, _ = HTMLExporter().from_notebook_node(nbformat.read(executed, as_version=4))
+    return write_html(executed)
+
+
+def write_html(executed: Path) -> Path:
+    """The executed notebook as HTML beside it (``<stem>.html``), which it returns."""
+    import nbformat
+    from nbconvert import HTMLExporter
+
+    with warnings.catch_warnings():  # glue's records (display=False) have no HTML form
+        warnings.filterwarnings("ignore", "Your element with mimetype", UserWarning)
+        body, _ = HTMLExporter().from_notebook_node(nbformat.read(executed, as_version=4))
     html = executed.with_suffix(".html")
     html.write_text(body, encoding="utf-8")
     return html
