@@ -109,3 +109,5 @@ def test_a_program_the_chapter_cannot_run_gets_one_line(tmp_path):
     assert texts == ["## Your program: `tolerance.ngc`",
                      f"not run: {bad}:3: G64 P blending tolerance: the block-overlap method has "
                      "no path tolerance\n"]  # fmt: skip
+    # the runner's line (make chapter), the chapter's HTML written all the same
+    assert chapter.refused(tmp_path / "out" / "lee2022_block_overlap.ipynb") == [texts[1].strip()]

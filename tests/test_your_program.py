@@ -122,6 +122,20 @@ def test_the_chapters_html_is_written_without_warnings(tmp_path):
     assert html == tmp_path / "chapter.html" and "<html" in html.read_text()
 
 
+def test_chapter_runner_reads_what_the_last_section_did_not_run(tmp_path):
+    nb = nbformat.v4.new_notebook()
+    last = nbformat.v4.new_code_cell("show_program(...)")
+    last.outputs = [nbformat.v4.new_output("display_data", data={"text/markdown": "## Yours"}),
+                    nbformat.v4.new_output("stream", name="stdout",
+                                           text="not run: part.ngc:3: no such word\n")]  # fmt: skip
+    nb.cells = [nbformat.v4.new_code_cell("print('not run: elsewhere')"), last]
+    nbformat.write(nb, tmp_path / "c.ipynb")
+    assert chapter.refused(tmp_path / "c.ipynb") == ["not run: part.ngc:3: no such word"]
+    last.outputs = last.outputs[:1]
+    nbformat.write(nb, tmp_path / "c.ipynb")
+    assert chapter.refused(tmp_path / "c.ipynb") == []
+
+
 def test_chapter_runner_finds_a_chapter_by_stem_or_path():
     root = repo_root()
     by_stem = chapter.resolve_notebook("lee2022_block_overlap", root)

@@ -10,7 +10,8 @@ never touched. The networks come from the chapter's cache in ``data/cache/`` (a 
 not run before trains them first).
 
 A notebook or program that does not exist, or a parameter the chapter does not take, is named in
-one line before anything runs (exit 2); a
+one line before anything runs (exit 2); an input the chapter's method cannot run is named in one
+line after the chapter ran (exit 2: the last section says ``not run: <reason>``); a
 chapter that fails names its partly executed notebook (exit 1).
 """
 
@@ -24,7 +25,7 @@ from pathlib import Path
 
 from .. import paths
 
-__all__ = ["check_names", "execute", "main", "resolve_notebook", "write_html"]
+__all__ = ["check_names", "execute", "main", "refused", "resolve_notebook", "write_html"]
 
 #: The kernel's figures: inline (the Makefile's notebooks use the same backend).
 NB_MPLBACKEND = "module://matplotlib_inline.backend_inline"
@@ -163,7 +164,22 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)  # fmt: skip
         return 1
     print(f"chapter: {out_dir / notebook.name}\nchapter: {html}")
-    return 0
+    reasons = refused(out_dir / notebook.name)
+    for reason in reasons:
+        print(f"chapter: {notebook.stem}: {reason}", file=sys.stderr)
+    return 2 if reasons else 0
+
+
+def refused(executed: Path) -> list[str]:
+    """The ``not run: <reason>`` lines of the executed chapter's last cell: the section that runs
+    the reader's input says so when the chapter's method cannot run it (the rest of the chapter
+    ran)."""
+    import nbformat
+
+    last = nbformat.read(executed, as_version=4).cells[-1]
+    lines = [line for o in last.get("outputs", []) if o.get("output_type") == "stream"
+             for line in o.get("text", "").splitlines()]  # fmt: skip
+    return [line for line in lines if line.startswith("not run: ")]
 
 
 if __name__ == "__main__":
