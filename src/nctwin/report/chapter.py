@@ -171,15 +171,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def refused(executed: Path) -> list[str]:
-    """The ``not run: <reason>`` lines of the executed chapter's last cell: the section that runs
-    the reader's input says so when the chapter's method cannot run it (the rest of the chapter
-    ran)."""
+    """The lines of ``not run: <reason>`` in the executed chapter's last cell (a reason may take
+    one line per bad value): the section that runs the reader's input says so when the chapter's
+    method cannot run it (the rest of the chapter ran)."""
     import nbformat
 
     last = nbformat.read(executed, as_version=4).cells[-1]
-    lines = [line for o in last.get("outputs", []) if o.get("output_type") == "stream"
-             for line in o.get("text", "").splitlines()]  # fmt: skip
-    return [line for line in lines if line.startswith("not run: ")]
+    texts = [o.get("text", "") for o in last.get("outputs", []) if o.get("output_type") == "stream"]
+    return [line for t in texts if t.startswith("not run: ") for line in t.splitlines()]
 
 
 if __name__ == "__main__":
