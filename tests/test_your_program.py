@@ -136,6 +136,26 @@ def test_chapter_runner_reads_what_the_last_section_did_not_run(tmp_path):
     assert chapter.refused(tmp_path / "c.ipynb") == []
 
 
+@pytest.mark.parametrize(("name", "value", "why"), [
+    ("n_seeds", "2.5", "takes a whole number (default 5)"),
+    ("n_seeds", "True", "takes a whole number (default 5)"),
+    ("duration_s", "long", "takes a number (default 13.0)"),
+])  # fmt: skip
+def test_chapter_runner_refuses_a_value_of_another_kind(capsys, name, value, why):
+    assert chapter.main(["denkena2020_force_lstm", "-p", name, value]) == 2
+    assert capsys.readouterr().err.endswith(f": denkena2020_force_lstm {why}\n")
+
+
+def test_chapter_runner_reads_values_as_the_notebook_does():
+    notebook = repo_root() / "notebooks" / "lee2022_block_overlap.ipynb"
+    read = {"False": False, "None": None, "3": 3, "0.5": 0.5, "a.ngc": "a.ngc"}
+    for text, value in read.items():
+        assert chapter._value(text) == value and type(chapter._value(text)) is type(value)
+    chapter.check_parameters(notebook, {"out_of_domain": False, "program": "part.ngc"})
+    with pytest.raises(ValueError, match=r"-p out_of_domain = 'no': .* takes True or False"):
+        chapter.check_parameters(notebook, {"out_of_domain": "no"})
+
+
 def test_chapter_runner_finds_a_chapter_by_stem_or_path():
     root = repo_root()
     by_stem = chapter.resolve_notebook("lee2022_block_overlap", root)

@@ -1,23 +1,24 @@
 """Run one chapter on a reader's program: ``make chapter NB=<notebook> PROGRAM=<file>``.
 
 ``python -m nctwin.report.chapter NOTEBOOK [--program FILE] [-p NAME VALUE ...] [--out DIR]``
-executes the notebook with papermill (``program`` set to FILE made absolute, and each ``-p``: a
-number where VALUE reads as one, else a string), headless, in the repository root,
-and writes the executed notebook and its HTML to ``DIR/<stem>.ipynb`` and ``DIR/<stem>.html``
-(default ``build/chapter/``). The chapter's tables and claims go to ``DIR/<stem>/results/``
-(through ``NCTWIN_RESULTS``): ``results/``, ``book/notebooks/`` and the committed notebooks are
-never touched. The networks come from the chapter's cache in ``data/cache/`` (a chapter that has
-not run before trains them first).
+executes the notebook with papermill (``program`` set to FILE made absolute, and each ``-p``:
+True, False, None or a number where VALUE reads as one, else a string), headless, in the
+repository root, and writes the executed notebook and its HTML to ``DIR/<stem>.ipynb`` and
+``DIR/<stem>.html`` (default ``build/chapter/``). The chapter's tables and claims go to
+``DIR/<stem>/results/`` (through ``NCTWIN_RESULTS``): ``results/``, ``book/notebooks/`` and the
+committed notebooks are never touched. The networks come from the chapter's cache in
+``data/cache/`` (a chapter that has not run before trains them first).
 
-A notebook or program that does not exist, or a parameter the chapter does not take, is named in
-one line before anything runs (exit 2); an input the chapter's method cannot run is named in one
-line after the chapter ran (exit 2: the last section says ``not run: <reason>``); a
-chapter that fails names its partly executed notebook (exit 1).
+A notebook or program that does not exist, a parameter the chapter does not take, or a value of
+another kind than its default is named in one line before anything runs (exit 2). An input the
+chapter's method cannot run is named in one line after the chapter ran (exit 2: its last section
+says ``not run: <reason>``). A chapter that fails names its partly executed notebook (exit 1).
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import sys
 import warnings
@@ -25,7 +26,7 @@ from pathlib import Path
 
 from .. import paths
 
-__all__ = ["check_names", "execute", "main", "refused", "resolve_notebook", "write_html"]
+__all__ = ["check_parameters", "execute", "main", "refused", "resolve_notebook", "write_html"]
 
 #: The kernel's figures: inline (the Makefile's notebooks use the same backend).
 NB_MPLBACKEND = "module://matplotlib_inline.backend_inline"
@@ -96,26 +97,50 @@ def write_html(executed: Path) -> Path:
     return html
 
 
-def check_names(notebook: Path, parameters: dict) -> None:
-    """Refuse, before anything runs, a parameter the chapter's parameters cell does not set.
+def check_parameters(notebook: Path, parameters: dict) -> None:
+    """Refuse, before anything runs, a parameter the chapter's parameters cell does not set, or a
+    value of another kind than the cell's default (a whole number where it is one, a number where
+    it is a float, True or False where it is either; any value where it is None).
 
     Raises
     ------
     ValueError
-        Naming the first unknown parameter, its value and the chapter's parameters.
+        Naming the first parameter refused, its value and what the chapter takes.
     """
     import papermill
 
-    known = list(papermill.inspect_notebook(str(notebook)))
+    known = papermill.inspect_notebook(str(notebook))
     for name, value in parameters.items():
+        flag = "PROGRAM" if name == "program" else f"-p {name}"
         if name not in known:
-            flag = "PROGRAM" if name == "program" else f"-p {name}"
             allowed = f"its parameters are {', '.join(known)}" if known else "it has none"
             raise ValueError(f"{flag} = {value!r}: {notebook.stem} takes no such parameter; "
                              f"{allowed}")  # fmt: skip
+        default = ast.literal_eval(known[name]["default"])
+        if not _fits(default, value):
+            raise ValueError(f"{flag} = {value!r}: {notebook.stem} takes "
+                             f"{_KIND_NAMES[type(default)]} (default {default!r})")  # fmt: skip
 
 
-def _value(text: str) -> int | float | str:
+#: What a parameter of each default's type takes, in words.
+_KIND_NAMES = {bool: "True or False", int: "a whole number", float: "a number"}
+
+
+def _fits(default: object, value: object) -> bool:
+    """Whether ``value`` is of the kind of the parameter's ``default`` (None takes anything)."""
+    if isinstance(default, bool) or isinstance(value, bool):
+        return default is None or type(value) is type(default)
+    if isinstance(default, int):
+        return isinstance(value, int)
+    if isinstance(default, float):
+        return isinstance(value, int | float)
+    return True
+
+
+def _value(text: str) -> bool | int | float | str | None:
+    """A ``-p`` value as the notebook reads it: True, False, None, a number, else the text."""
+    if text in ("True", "False", "None"):
+        return ast.literal_eval(text)
     for kind in (int, float):
         try:
             return kind(text)
@@ -149,7 +174,7 @@ def main(argv: list[str] | None = None) -> int:
             if not program.is_file():
                 raise ValueError(f"PROGRAM={args.program}: no such file")
             parameters["program"] = str(program)
-        check_names(notebook, parameters)
+        check_parameters(notebook, parameters)
     except ValueError as exc:
         print(f"chapter: {exc}", file=sys.stderr)
         return 2
