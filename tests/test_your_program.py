@@ -154,6 +154,7 @@ def test_chapter_runner_reads_values_as_the_notebook_does():
     chapter.check_parameters(notebook, {"out_of_domain": False, "program": "part.ngc"})
     with pytest.raises(ValueError, match=r"-p out_of_domain = 'no': .* takes True or False"):
         chapter.check_parameters(notebook, {"out_of_domain": "no"})
+    assert chapter._fits(chapter._literal("np.arange(3)"), "anything")  # an expression
 
 
 def test_chapter_runner_finds_a_chapter_by_stem_or_path():

@@ -116,7 +116,7 @@ def check_parameters(notebook: Path, parameters: dict) -> None:
             allowed = f"its parameters are {', '.join(known)}" if known else "it has none"
             raise ValueError(f"{flag} = {value!r}: {notebook.stem} takes no such parameter; "
                              f"{allowed}")  # fmt: skip
-        default = ast.literal_eval(known[name]["default"])
+        default = _literal(known[name]["default"])
         if not _fits(default, value):
             raise ValueError(f"{flag} = {value!r}: {notebook.stem} takes "
                              f"{_KIND_NAMES[type(default)]} (default {default!r})")  # fmt: skip
@@ -124,6 +124,14 @@ def check_parameters(notebook: Path, parameters: dict) -> None:
 
 #: What a parameter of each default's type takes, in words.
 _KIND_NAMES = {bool: "True or False", int: "a whole number", float: "a number"}
+
+
+def _literal(source: str) -> object:
+    """A parameter's default as Python reads it; None (any value) where it is an expression."""
+    try:
+        return ast.literal_eval(source)
+    except (ValueError, SyntaxError):
+        return None
 
 
 def _fits(default: object, value: object) -> bool:
