@@ -52,6 +52,7 @@ __all__ = [
     "error_sources",
     "logger_variant",
     "machine_check",
+    "member_feeds",
     "part_stats",
     "predict_all_feeds",
     "predict_feeds",
@@ -352,14 +353,30 @@ def predict_feeds(members: list[list[Trained]], run: PocketRun) -> np.ndarray:
 
 def predict_all_feeds(members: list[list[Trained]], runs: list[PocketRun]) -> list[np.ndarray]:
     """:func:`predict_feeds` of several pockets, each network run once over all of them."""
+    return _mean_feeds(members, _axis_inputs(runs), runs)
+
+
+def member_feeds(members: list[list[Trained]], runs: list[PocketRun]) -> list[list[np.ndarray]]:
+    """Each member's (seed's) :func:`predict_all_feeds` of the pockets, their features gathered
+    once for all members."""
+    xs = _axis_inputs(runs)
+    return [_mean_feeds([models], xs, runs) for models in members]
+
+
+def _axis_inputs(runs: list[PocketRun]) -> list[np.ndarray]:
+    """The pockets' features, one contiguous (N, 9) array per axis."""
     x = np.concatenate([r.features for r in runs])
+    return [np.ascontiguousarray(x[:, a]) for a in range(x.shape[1])]
+
+
+def _mean_feeds(
+    members: list[list[Trained]], xs: list[np.ndarray], runs: list[PocketRun]
+) -> list[np.ndarray]:
     feeds = np.mean(
-        [
-            np.column_stack([m.predict(x[:, a])[:, 0] for a, m in enumerate(models)])
-            for models in members
-        ],
+        [np.column_stack([m.predict(xs[a])[:, 0] for a, m in enumerate(models)])
+         for models in members],
         axis=0,
-    )
+    )  # fmt: skip
     return np.split(feeds, np.cumsum([len(r.features) for r in runs])[:-1])
 
 
@@ -380,7 +397,7 @@ def predict_times(
     members: list[list[Trained]], runs: list[PocketRun]
 ) -> list[tuple[float, np.ndarray]]:
     """:func:`predict_time` of several pockets, each network run once over all of them."""
-    per_member = [predict_all_feeds([m], runs) for m in members]
+    per_member = member_feeds(members, runs)
     out = []
     for k, run in enumerate(runs):
         lengths = run.toolpath.lengths_mm

@@ -22,7 +22,7 @@ from ..report.claims import Claim, bootstrap_interval, with_seeds
 from ..report.conditions import Condition
 from ..report.papers import load_paper_table
 from ..toolpath import MotionKind
-from .sun2022 import IMPROVED_POCKETS, PocketRun, predict_all_feeds
+from .sun2022 import IMPROVED_POCKETS, PocketRun, member_feeds
 
 __all__ = [
     "CAM_POINTS",
@@ -127,7 +127,7 @@ def seed_feeds(ensembles: dict[str, list[list[Trained]]], runs: list[PocketRun])
     ndarray, shape (n_seeds, n_models, N, 3)
         :func:`seed_times` makes each seed's times of them.
     """
-    per_model = [[np.concatenate(predict_all_feeds([m], runs)) for m in members]
+    per_model = [[np.concatenate(feeds) for feeds in member_feeds(members, runs)]
                  for members in ensembles.values()]  # fmt: skip
     return np.stack(per_model, axis=1)
 
