@@ -99,6 +99,15 @@ def test_show_text_is_what_print_format_table_prints(monkeypatch):
     assert obj["text/html"] == html_table(frame())
 
 
+def test_show_transposed_html_keeps_the_text(monkeypatch):
+    shown = []
+    monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append(obj))
+    display.show(frame(), transpose=True)
+    assert shown[0]["text/plain"] == display.format_table(frame())
+    assert shown[0]["text/html"] == html_table(frame(), transpose=True)
+    assert shown[0]["text/html"] != html_table(frame(), transpose=False)
+
+
 def test_show_paper_keeps_format_paper_table_text(monkeypatch):
     shown = []
     monkeypatch.setattr("IPython.display.display", lambda obj, raw: shown.append(obj))

@@ -91,7 +91,13 @@ def format_paper_table(df: pd.DataFrame, name: str | None = None) -> str:
     return _with_footnotes("\n".join(lines), footnotes)
 
 
-def show(df: pd.DataFrame, *, digits: int = 4, notes: str | None = None) -> None:
+def show(
+    df: pd.DataFrame,
+    *,
+    digits: int = 4,
+    notes: str | None = None,
+    transpose: bool | None = None,
+) -> None:
     """Display a table once: compact HTML in the book, :func:`format_table` text beside it.
 
     One display object carries both forms: ``text/html`` (:func:`nctwin.report.html.html_table`,
@@ -101,13 +107,15 @@ def show(df: pd.DataFrame, *, digits: int = 4, notes: str | None = None) -> None
     printed ``format_table(table)`` and displayed the frame.
 
     ``notes`` names a column of texts shown as numbered footnotes below the table, the column
-    holding their numbers (``[1]`` ...); it is left out where no row has a text.
+    holding their numbers (``[1]`` ...); it is left out where no row has a text. ``transpose``
+    is :func:`~nctwin.report.html.html_table`'s (``True``: one row per column, e.g. a claim per
+    column and a seed per row); the text is the table as it is.
     """
     from IPython.display import display
 
     body, footnotes = _footnoted(df, notes) if notes else (df, [])
     text = _with_footnotes(format_table(body), footnotes)
-    page = html_table(body, digits=digits, notes=footnotes)
+    page = html_table(body, digits=digits, notes=footnotes, transpose=transpose)
     display({"text/plain": text, "text/html": page}, raw=True)
 
 
